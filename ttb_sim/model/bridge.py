@@ -1,0 +1,385 @@
+# Copyright 2026 The ttb_sim Authors
+#
+# Licensed under the Apache License, Version 2.0 (the "License");
+# you may not use this file except in compliance with the License.
+# You may obtain a copy of the License at
+#
+#     http://www.apache.org/licenses/LICENSE-2.0
+#
+# Unless required by applicable law or agreed to in writing, software
+# distributed under the License is distributed on an "AS IS" BASIS,
+# WITHOUT WARRANTIES OR CONDITIONS OF ANY KIND, either express or implied.
+# See the License for the specific language governing permissions and
+# limitations under the License.
+
+"""
+Multi-span simply supported girders on bearings, piers and foundations.
+
+Geometry (REP 103 track frame: x along the track, y left, z up): girder k
+(0-based) spans x in [k L, (k + 1) L] at z = 0 and rests on supports k and k + 1.
+Supports 0 and n_spans are abutments (always rigid ground); the intermediate ones
+are piers. Bearings are point spring-dashpots ([P] Eq. 1 lumped to a point) at
+y = +/- spacing/2 under each girder end. With rigid bearings the girder ends are
+ideal pins (uy, uz and twist fixed at both ends, ux at the first end). With
+spring foundations each pier is a column of 3-D beam elements from z = 0 down to
+z = -height, on 6-DOF foundation springs ([P] Table 4).
+
+All structural displacements are increments over the dead-load state of the
+bridge, as a monitoring system zeroed before the passage would measure them.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+import math
+
+import numpy as np
+import scipy.sparse as sp
+
+from ttb_sim.fe.assembly import assemble, link_kinematics, link_matrices
+from ttb_sim.fe.beam import BeamSection, global_matrices, NODE_DOFS, vertical_row, W_DOFS
+from ttb_sim.scenario import Scenario
+
+
+@dataclass(frozen=True)
+class GirderLine:
+    """
+    Lookup from a position along the track to the girder element under it.
+
+    DOF indices are *extended free* indices: constrained DOFs map to ``n_free``,
+    a slot that always holds zero (see :class:`Structure`).
+    """
+
+    span_length: float
+    n_spans: int
+    elements_per_span: int
+    w_dofs: np.ndarray
+    """(n_elements, 4) extended free index of (uz1, ry1, uz2, ry2)."""
+    w_dofs_full: np.ndarray
+    """(n_elements, 4) full DOF index of the same."""
+
+    @property
+    def length(self) -> float:
+        """Total length of the bridge (m)."""
+        return self.span_length * self.n_spans
+
+    @property
+    def element_length(self) -> float:
+        """Length of one girder element (m)."""
+        return self.span_length / self.elements_per_span
+
+    def locate(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """
+        Find the element and local coordinate of positions along the track.
+
+        Returns
+        -------
+        (element, xi, on_bridge)
+            Element index (clipped to valid), local coordinate in [0, 1], and a
+            mask that is True where 0 <= x <= length.
+
+        """
+        x = np.asarray(x, dtype=float)
+        on = (x >= 0.0) & (x <= self.length)
+        h = self.element_length
+        n_el = self.n_spans * self.elements_per_span
+        element = np.clip(np.floor(x / h).astype(int), 0, n_el - 1)
+        xi = np.clip(x / h - element, 0.0, 1.0)
+        return element, xi, on
+
+    def rows(self, x: np.ndarray, derivative: int = 0) -> tuple[np.ndarray, np.ndarray]:
+        """
+        Return the rows that map element DOFs to the girder deflection w at x.
+
+        Positions off the bridge get zero rows.
+
+        Returns
+        -------
+        (element, values)
+            Element index (n_points,) and coefficients (n_points, 4) of w
+            (derivative 0), dw/dx (1) or d2w/dx2 (2) on the element's
+            (uz1, ry1, uz2, ry2); index ``w_dofs`` or ``w_dofs_full`` with the
+            element to get the DOFs.
+
+        """
+        element, xi, on = self.locate(x)
+        values = vertical_row(xi, self.element_length, derivative) * on[:, None]
+        return element, values
+
+
+@dataclass(frozen=True)
+class Bearings:
+    """Elastic bearings as spring-dashpot links between girder ends and supports."""
+
+    kinematics: np.ndarray
+    """(n, 3, 12) relative displacement of the bearing from the two nodes' DOFs."""
+    dofs: np.ndarray
+    """(n, 12) extended free indices (ground = the zero slot)."""
+    stiffness: np.ndarray
+    """(n, 3) stiffness along x, y, z (N/m)."""
+    damping: np.ndarray
+    """(n, 3) damping along x, y, z (N s/m)."""
+    support: np.ndarray
+    """(n,) support index (0 = first abutment)."""
+    side: np.ndarray
+    """(n,) 0 = left (+y), 1 = right (-y)."""
+
+
+@dataclass(frozen=True)
+class RigidSupports:
+    """Ideal pinned girder ends: reactions come from the constrained rows."""
+
+    rows_k: sp.csr_matrix
+    rows_c: sp.csr_matrix
+    rows_m: sp.csr_matrix
+    """Rows of K, C, M for the constrained DOFs, over the extended free DOFs."""
+    full_dofs: np.ndarray
+    """(n_c,) full DOF index of each constrained DOF (for its applied load)."""
+    support: np.ndarray
+    """(n_c,) support index of each constrained DOF."""
+    component: np.ndarray
+    """(n_c,) 0..2 = force x, y, z; 3 = moment about x."""
+
+
+@dataclass(frozen=True)
+class Structure:
+    """
+    Assembled bridge: free-DOF matrices and the sensors defined on them.
+
+    The state vectors of the solver hold the free DOFs; gathers use an extended
+    vector with one more slot, index ``n_free``, that stands for every
+    constrained DOF and always holds zero.
+    """
+
+    mass: sp.csr_matrix
+    damping: sp.csr_matrix
+    stiffness: sp.csr_matrix
+    n_full: int
+    free: np.ndarray
+    """Full DOF index of each free DOF."""
+    full_to_free: np.ndarray
+    """Extended free index of each full DOF."""
+    girder: GirderLine
+    midspan_dofs: np.ndarray
+    """(n_spans, 3) extended free indices of ux, uy, uz at each mid-span node."""
+    bearings: Bearings | None
+    rigid: RigidSupports | None
+    n_supports: int
+    bearing_spacing: float
+    fundamental_frequency: float
+    """First vertical bending frequency of a simply supported span (Hz)."""
+    rayleigh: tuple[float, float]
+    """Rayleigh coefficients (a0, a1) of C = a0 M + a1 K for the beams."""
+
+    @property
+    def n_free(self) -> int:
+        """Number of free DOFs."""
+        return int(self.free.size)
+
+
+def span_frequency(span_length: float, bending_stiffness: float, mass_per_length: float,
+                   mode: int = 1) -> float:
+    """Return f_j = j^2 pi / (2 L^2) sqrt(EI/m) of a simply supported beam (Hz)."""
+    root = math.sqrt(bending_stiffness / mass_per_length)
+    return mode**2 * math.pi / (2 * span_length**2) * root
+
+
+def rayleigh_coefficients(ratio: float, f1: float, f2: float) -> tuple[float, float]:
+    """Return (a0, a1) giving the damping ratio exactly at f1 and f2 (Hz)."""
+    w1, w2 = 2 * math.pi * f1, 2 * math.pi * f2
+    return 2 * ratio * w1 * w2 / (w1 + w2), 2 * ratio / (w1 + w2)
+
+
+def build_structure(scenario: Scenario) -> Structure:
+    """
+    Assemble the bridge of a scenario (once, before time stepping).
+
+    Returns
+    -------
+    Structure
+
+    """
+    b, br, pr, fd = scenario.bridge, scenario.bearings, scenario.piers, scenario.foundation
+    n_spans, ne, span = b.n_spans, b.elements_per_span, b.span_length
+    n_supports = n_spans + 1
+    piers = fd.model == 'springs'
+
+    # Nodes: girders first (ne + 1 per span), then pier columns (top node first).
+    xg = (np.arange(n_spans)[:, None] * span
+          + np.linspace(0.0, span, ne + 1)[None, :]).ravel()
+    coords = [np.column_stack([xg, np.zeros_like(xg), np.zeros_like(xg)])]
+    girder_nodes = np.arange(n_spans * (ne + 1)).reshape(n_spans, ne + 1)
+    first = girder_nodes[:, :-1].ravel()
+    conn = [np.column_stack([first, first + 1])]
+    sections = [_uniform_section(conn[0].shape[0], b.axial_stiffness, b.torsional_stiffness,
+                                 b.bending_stiffness, b.lateral_bending_stiffness,
+                                 b.mass_per_length, b.torsional_inertia)]
+    n_nodes = girder_nodes.size
+    pier_top = np.full(n_supports, -1)
+    pier_base = np.full(n_supports, -1)
+    if piers:
+        npe = pr.elements
+        zp = -np.linspace(0.0, pr.height, npe + 1)
+        for s in range(1, n_spans):
+            ids = n_nodes + np.arange(npe + 1)
+            coords.append(np.column_stack([np.full(npe + 1, s * span),
+                                           np.zeros(npe + 1), zp]))
+            conn.append(np.column_stack([ids[:-1], ids[1:]]))
+            pier_top[s], pier_base[s] = ids[0], ids[-1]
+            n_nodes += npe + 1
+        n_pier_el = (n_spans - 1) * npe
+        if n_pier_el:
+            sections.append(_uniform_section(n_pier_el, pr.axial_stiffness,
+                                             pr.torsional_stiffness, pr.bending_stiffness,
+                                             pr.bending_stiffness, pr.mass_per_length,
+                                             pr.mass_per_length))
+    xyz = np.concatenate(coords)
+    elements = np.concatenate(conn)
+    section = BeamSection(*(np.concatenate([getattr(s, f) for s in sections])
+                            for f in ('ea', 'gj', 'ei_y', 'ei_z', 'mass', 'inertia_x')))
+    n_full = n_nodes * NODE_DOFS
+    edofs = (elements[:, :, None] * NODE_DOFS + np.arange(NODE_DOFS)).reshape(-1, 12)
+    ke, me, _ = global_matrices(xyz[elements[:, 0]], xyz[elements[:, 1]], section)
+    k_beam = assemble(n_full, edofs, ke)
+    m_full = assemble(n_full, edofs, me)
+
+    f1 = span_frequency(span, b.bending_stiffness, b.mass_per_length)
+    a0, a1 = rayleigh_coefficients(b.damping_ratio, f1, 4 * f1)
+    c_full = (a0 * m_full + a1 * k_beam).tocsr()
+    k_full = k_beam.copy()
+
+    # Supports.
+    constrained = np.zeros(n_full, dtype=bool)
+    ends = np.stack([girder_nodes[:, 0], girder_nodes[:, -1]], axis=1)  # (n_spans, 2)
+    end_support = np.stack([np.arange(n_spans), np.arange(1, n_spans + 1)], axis=1)
+    bearing_links = None
+    if br.model == 'rigid':
+        comp_list, dof_list, sup_list = [], [], []
+        for end in (0, 1):
+            comps = (0, 1, 2, 3) if end == 0 else (1, 2, 3)
+            for c in comps:
+                dof_list.append(ends[:, end] * NODE_DOFS + c)
+                sup_list.append(end_support[:, end])
+                comp_list.append(np.full(n_spans, c))
+        cdofs = np.concatenate(dof_list)
+        constrained[cdofs] = True
+    else:
+        e = br.spacing / 2
+        girder_end = np.repeat(ends.ravel(), 2)               # node, per side
+        support = np.repeat(end_support.ravel(), 2)
+        side = np.tile([0, 1], ends.size)
+        arm = np.column_stack([np.zeros(side.size), np.where(side == 0, e, -e),
+                               np.zeros(side.size)])
+        top = pier_top[support]
+        kin = link_kinematics(arm, np.where((top >= 0)[:, None], arm, 0.0))
+        kdir = np.tile([br.longitudinal_stiffness, br.lateral_stiffness,
+                        br.vertical_stiffness], (side.size, 1))
+        cdir = np.tile([br.lateral_damping, br.lateral_damping, br.vertical_damping],
+                       (side.size, 1))
+        node_b = np.where(top >= 0, top, 0)
+        full_b = node_b[:, None] * NODE_DOFS + np.arange(NODE_DOFS)
+        ground = np.repeat(top < 0, NODE_DOFS).reshape(-1, NODE_DOFS)
+        link_full = np.concatenate([girder_end[:, None] * NODE_DOFS + np.arange(NODE_DOFS),
+                                    np.where(ground, -1, full_b)], axis=1)
+        keep = link_full >= 0
+        kl = link_matrices(kin, kdir) * keep[:, :, None] * keep[:, None, :]
+        cl = link_matrices(kin, cdir) * keep[:, :, None] * keep[:, None, :]
+        safe = np.where(keep, link_full, 0)
+        k_full = k_full + assemble(n_full, safe, kl)
+        c_full = c_full + assemble(n_full, safe, cl)
+        bearing_links = (kin, link_full, kdir, cdir, support, side)
+    if piers and n_spans > 1:
+        base = pier_base[1:n_spans]
+        bdofs = (base[:, None] * NODE_DOFS + np.arange(NODE_DOFS)).ravel()
+        kf = np.tile([fd.lateral_stiffness, fd.lateral_stiffness, fd.vertical_stiffness,
+                      fd.rotational_stiffness, fd.rotational_stiffness,
+                      fd.rotational_stiffness], base.size)
+        cf = np.tile([fd.damping, fd.damping, fd.damping, 0.0, 0.0, 0.0], base.size)
+        k_full = k_full + sp.csr_matrix((kf, (bdofs, bdofs)), shape=(n_full, n_full))
+        c_full = c_full + sp.csr_matrix((cf, (bdofs, bdofs)), shape=(n_full, n_full))
+
+    free = np.flatnonzero(~constrained)
+    n_free = free.size
+    full_to_free = np.full(n_full, n_free)
+    full_to_free[free] = np.arange(n_free)
+
+    def reduce(a: sp.csr_matrix) -> sp.csr_matrix:
+        return a[free][:, free].tocsr()
+
+    rigid = None
+    if br.model == 'rigid':
+        def rows(a: sp.csr_matrix) -> sp.csr_matrix:
+            r = a[cdofs][:, free].tocsc()
+            return sp.hstack([r, sp.csc_matrix((cdofs.size, 1))]).tocsr()
+
+        rigid = RigidSupports(rows_k=rows(k_full), rows_c=rows(c_full), rows_m=rows(m_full),
+                              full_dofs=cdofs, support=np.concatenate(sup_list),
+                              component=np.concatenate(comp_list))
+    bearings = None
+    if bearing_links is not None:
+        kin, link_full, kdir, cdir, support, side = bearing_links
+        ext = np.where(link_full >= 0, full_to_free[np.maximum(link_full, 0)], n_free)
+        bearings = Bearings(kinematics=kin, dofs=ext, stiffness=kdir, damping=cdir,
+                            support=support, side=side)
+
+    el_nodes = conn[0]
+    wfull = el_nodes[:, [0, 0, 1, 1]] * NODE_DOFS + W_DOFS % NODE_DOFS
+    girder = GirderLine(span_length=span, n_spans=n_spans, elements_per_span=ne,
+                        w_dofs=full_to_free[wfull], w_dofs_full=wfull)
+    mid = girder_nodes[:, ne // 2]
+    midspan = full_to_free[mid[:, None] * NODE_DOFS + np.arange(3)]
+    return Structure(mass=reduce(m_full), damping=reduce(c_full), stiffness=reduce(k_full),
+                     n_full=n_full, free=free, full_to_free=full_to_free, girder=girder,
+                     midspan_dofs=midspan, bearings=bearings, rigid=rigid,
+                     n_supports=n_supports, bearing_spacing=br.spacing,
+                     fundamental_frequency=f1, rayleigh=(a0, a1))
+
+
+def _uniform_section(n: int, ea: float, gj: float, ei_y: float, ei_z: float, mass: float,
+                     inertia_x: float) -> BeamSection:
+    return BeamSection(*(np.full(n, v, dtype=float)
+                         for v in (ea, gj, ei_y, ei_z, mass, inertia_x)))
+
+
+def bearing_forces(structure: Structure, u: np.ndarray, v: np.ndarray, a: np.ndarray,
+                   load_full: np.ndarray) -> np.ndarray:
+    """
+    Return the force each support receives from its bearings (N).
+
+    Parameters
+    ----------
+    structure : Structure
+        The assembled bridge.
+    u, v, a : arrays
+        Extended free displacement, velocity and acceleration (last slot zero).
+    load_full : array
+        Applied load on the full DOFs (used for loads sitting on a rigid support).
+
+    Returns
+    -------
+    numpy.ndarray
+        Shape (n_supports, 2, 3): left/right bearings, force (x, y, z) in track
+        axes acting ON the support (downward = negative z).
+
+    """
+    out = np.zeros((structure.n_supports, 2, 3))
+    if structure.bearings is not None:
+        bg = structure.bearings
+        d = np.einsum('eai,ei->ea', bg.kinematics, u[bg.dofs])
+        dv = np.einsum('eai,ei->ea', bg.kinematics, v[bg.dofs])
+        force = bg.stiffness * d + bg.damping * dv
+        np.add.at(out, (bg.support, bg.side), force)
+        return out
+    rg = structure.rigid
+    reaction = rg.rows_k @ u + rg.rows_c @ v + rg.rows_m @ a - load_full[rg.full_dofs]
+    on_support = -reaction
+    e2 = structure.bearing_spacing
+    comp = rg.component
+    for c in (0, 1, 2):
+        sel = comp == c
+        np.add.at(out, (rg.support[sel], 0, c), 0.5 * on_support[sel])
+        np.add.at(out, (rg.support[sel], 1, c), 0.5 * on_support[sel])
+    sel = comp == 3
+    np.add.at(out, (rg.support[sel], 0, 2), on_support[sel] / e2)
+    np.add.at(out, (rg.support[sel], 1, 2), -on_support[sel] / e2)
+    return out

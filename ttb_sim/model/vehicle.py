@@ -1,0 +1,91 @@
+# Copyright 2026 The ttb_sim Authors
+#
+# Licensed under the Apache License, Version 2.0 (the "License");
+# you may not use this file except in compliance with the License.
+# You may obtain a copy of the License at
+#
+#     http://www.apache.org/licenses/LICENSE-2.0
+#
+# Unless required by applicable law or agreed to in writing, software
+# distributed under the License is distributed on an "AS IS" BASIS,
+# WITHOUT WARRANTIES OR CONDITIONS OF ANY KIND, either express or implied.
+# See the License for the specific language governing permissions and
+# limitations under the License.
+
+"""
+Reduced vehicle models that run on the girders: moving forces and quarter cars.
+
+Axles are listed by their distance behind the train head. A quarter car is a
+sprung mass on a linear spring-dashpot over a wheel of (optional) unsprung mass
+that stays in contact with what it runs on: the girder on the bridge, rigid
+ground off it. Vehicle displacements are measured from static equilibrium, z up.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ttb_sim.scenario import G, TrainConfig
+
+
+@dataclass(frozen=True)
+class Axles:
+    """Axle layout of a train."""
+
+    offsets: np.ndarray
+    """Distance of each axle behind the head (m), shape (n_axles,)."""
+
+    @property
+    def count(self) -> int:
+        """Number of axles."""
+        return int(self.offsets.size)
+
+    @property
+    def train_length(self) -> float:
+        """Distance from the head to the last axle (m)."""
+        return float(self.offsets.max()) if self.count else 0.0
+
+
+@dataclass(frozen=True)
+class MovingForces:
+    """Constant vertical forces (N, downward), one per axle."""
+
+    axles: Axles
+    loads: np.ndarray
+
+
+@dataclass(frozen=True)
+class QuarterCars:
+    """One quarter car per axle (arrays of shape (n_axles,), SI units)."""
+
+    axles: Axles
+    sprung_mass: np.ndarray
+    unsprung_mass: np.ndarray
+    stiffness: np.ndarray
+    damping: np.ndarray
+
+    @property
+    def static_load(self) -> np.ndarray:
+        """Static contact force of each wheel (N)."""
+        return (self.sprung_mass + self.unsprung_mass) * G
+
+    def natural_frequency(self) -> np.ndarray:
+        """Bounce frequency of each sprung mass on its suspension, wheel fixed (Hz)."""
+        return np.sqrt(self.stiffness / self.sprung_mass) / (2 * np.pi)
+
+
+Vehicle = MovingForces | QuarterCars
+
+
+def build_vehicle(train: TrainConfig) -> Vehicle:
+    """Build the vehicle model a scenario's train section describes."""
+    axles = Axles(offsets=np.asarray(train.axle_positions(), dtype=float))
+    n = axles.count
+    if train.vehicle == 'moving_force':
+        return MovingForces(axles=axles, loads=np.full(n, train.axle_load))
+    return QuarterCars(axles=axles, sprung_mass=np.full(n, train.sprung_mass),
+                       unsprung_mass=np.full(n, train.unsprung_mass),
+                       stiffness=np.full(n, train.suspension_stiffness),
+                       damping=np.full(n, train.suspension_damping))

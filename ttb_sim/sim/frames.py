@@ -1,0 +1,66 @@
+# Copyright 2026 The ttb_sim Authors
+#
+# Licensed under the Apache License, Version 2.0 (the "License");
+# you may not use this file except in compliance with the License.
+# You may obtain a copy of the License at
+#
+#     http://www.apache.org/licenses/LICENSE-2.0
+#
+# Unless required by applicable law or agreed to in writing, software
+# distributed under the License is distributed on an "AS IS" BASIS,
+# WITHOUT WARRANTIES OR CONDITIONS OF ANY KIND, either express or implied.
+# See the License for the specific language governing permissions and
+# limitations under the License.
+
+"""Frames: what the stepping core emits at each output tick (SI units, track axes)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+
+@dataclass(frozen=True)
+class Layout:
+    """Sizes of the things a run reports, known before the first frame."""
+
+    n_spans: int
+    n_supports: int
+    n_bodies: int
+    """Number of car bodies with an IMU (quarter cars: one per axle)."""
+
+
+@dataclass(frozen=True)
+class Frame:
+    """
+    The observable state at one output tick.
+
+    Attributes
+    ----------
+    step : solver step index
+    time : simulation time (s)
+    head_position : position of the train head along the track (m)
+    speed : train speed (m/s)
+    midspan : (n_spans, 3) girder mid-span displacement (m), z up
+    bearings : (n_supports, 2, 3) bearing forces on each support, left/right (N)
+    body_acceleration : (n_bodies, 3) car-body acceleration, gravity excluded (m/s^2)
+    body_angular_velocity : (n_bodies, 3) car-body angular velocity (rad/s)
+    contact_force : (n_bodies, 3) force of the rail on each body's wheel (N), z up
+
+    """
+
+    step: int
+    time: float
+    head_position: float
+    speed: float
+    midspan: np.ndarray
+    bearings: np.ndarray
+    body_acceleration: np.ndarray
+    body_angular_velocity: np.ndarray
+    contact_force: np.ndarray
+
+    @property
+    def stamp_ns(self) -> int:
+        """Simulation time in integer nanoseconds (message stamps)."""
+        return int(round(self.time * 1e9))

@@ -1,0 +1,106 @@
+# Copyright 2026 The ttb_sim Authors
+#
+# Licensed under the Apache License, Version 2.0 (the "License");
+# you may not use this file except in compliance with the License.
+# You may obtain a copy of the License at
+#
+#     http://www.apache.org/licenses/LICENSE-2.0
+#
+# Unless required by applicable law or agreed to in writing, software
+# distributed under the License is distributed on an "AS IS" BASIS,
+# WITHOUT WARRANTIES OR CONDITIONS OF ANY KIND, either express or implied.
+# See the License for the specific language governing permissions and
+# limitations under the License.
+
+"""Newmark average-acceleration time integration with a once-factorised matrix."""
+
+from __future__ import annotations
+
+import numpy as np
+import scipy.sparse as sp
+import scipy.sparse.linalg as sla
+
+
+class Newmark:
+    """
+    Newmark's average-acceleration method (beta = 1/4, gamma = 1/2) for M a + C v + K u = f.
+
+    The effective matrix K + 2/dt C + 4/dt^2 M is factorised once; each step is
+    one sparse forward/back substitution (for any number of right-hand sides).
+    The method is unconditionally stable, has no numerical damping and a
+    relative period error of about (omega dt)^2 / 12.
+
+    Parameters
+    ----------
+    mass, damping, stiffness : sparse matrices
+        System matrices (n x n).
+    dt : float
+        Time step (s).
+
+    """
+
+    def __init__(self, mass: sp.spmatrix, damping: sp.spmatrix, stiffness: sp.spmatrix,
+                 dt: float) -> None:
+        self.dt = float(dt)
+        self.a0 = 4.0 / dt**2
+        self.a1 = 2.0 / dt
+        self.mass = sp.csr_matrix(mass)
+        self.damping = sp.csr_matrix(damping)
+        self.stiffness = sp.csr_matrix(stiffness)
+        effective = (self.stiffness + self.a1 * self.damping + self.a0 * self.mass).tocsc()
+        self._lu = sla.splu(effective)
+
+    def history(self, u: np.ndarray, v: np.ndarray,
+                a: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """
+        Return (h_v, h_a) with v_{n+1} = a1 u_{n+1} + h_v and a_{n+1} = a0 u_{n+1} + h_a.
+
+        These express the end-of-step velocity and acceleration through the
+        unknown end-of-step displacement.
+        """
+        h_v = -self.a1 * u - v
+        h_a = -self.a0 * u - 2.0 * self.a1 * v - a
+        return h_v, h_a
+
+    def effective_load(self, force: np.ndarray, h_v: np.ndarray, h_a: np.ndarray) -> np.ndarray:
+        """Return the right-hand side f_{n+1} - M h_a - C h_v of the effective system."""
+        return force - self.mass @ h_a - self.damping @ h_v
+
+    def solve(self, rhs: np.ndarray) -> np.ndarray:
+        """Solve the effective system for one or several right-hand sides."""
+        return self._lu.solve(rhs)
+
+    def finish(self, u_new: np.ndarray, h_v: np.ndarray,
+               h_a: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Return the end-of-step velocity and acceleration."""
+        return self.a1 * u_new + h_v, self.a0 * u_new + h_a
+
+    def step(self, u: np.ndarray, v: np.ndarray, a: np.ndarray,
+             force: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """
+        Advance one step of an uncoupled system.
+
+        Parameters
+        ----------
+        u, v, a : arrays
+            State at t_n.
+        force : array
+            Load at t_{n+1}.
+
+        Returns
+        -------
+        (u, v, a) at t_{n+1}.
+
+        """
+        h_v, h_a = self.history(u, v, a)
+        u_new = self.solve(self.effective_load(force, h_v, h_a))
+        v_new, a_new = self.finish(u_new, h_v, h_a)
+        return u_new, v_new, a_new
+
+    def initial_acceleration(self, u: np.ndarray, v: np.ndarray,
+                             force: np.ndarray) -> np.ndarray:
+        """Return M^-1 (f - C v - K u), the acceleration consistent with a start state."""
+        rhs = force - self.damping @ v - self.stiffness @ u
+        if not np.any(rhs):
+            return np.zeros_like(rhs)
+        return sla.spsolve(self.mass.tocsc(), rhs)
