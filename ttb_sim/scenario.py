@@ -121,8 +121,10 @@ class TrainConfig:
     vehicle: str = param('moving_force', '-', 'Vehicle model: constant moving forces, or '
                          'quarter cars (a sprung mass on a spring-dashpot over each axle).',
                          choices=('moving_force', 'sprung_mass'))
-    speed_kmh: float = param(300.0, 'km/h', 'Running speed of the train.', low=0.0,
-                             high=600.0, low_inclusive=False, dynamic=True)
+    speed_kmh: float = param(300.0, 'km/h', 'Running speed of the train (the upper bound '
+                             'is a numerical guard: validation runs use high speed '
+                             'parameters).', low=0.0, high=10000.0, low_inclusive=False,
+                             dynamic=True)
     start_position: float = param(0.0, 'm', 'Position of the train head along the track at '
                                   't = 0 (0 is the start of the first span).',
                                   low=-5000.0, high=5000.0)

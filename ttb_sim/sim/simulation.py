@@ -113,21 +113,27 @@ class Simulation:
                  self.vehicle.axles.count, dt, self.n_steps)
 
     @property
+    def exit_position(self) -> float:
+        """Head position (m) at which the last axle leaves the bridge."""
+        return self.structure.girder.length + self.vehicle.axles.train_length
+
+    @property
     def n_frames(self) -> int:
         """Number of frames :meth:`frames` yields."""
         return self.n_steps // self.output_every + 1
 
     def auto_duration(self) -> float:
         """Return the time for the last axle to leave the bridge plus free vibration (s)."""
-        tr = self.scenario.train
-        travel = self.structure.girder.length + self.vehicle.axles.train_length \
-            - tr.start_position
+        travel = self.exit_position - self.scenario.train.start_position
         free = self.scenario.solver.free_vibration_periods / self.structure.fundamental_frequency
         return max(travel, 0.0) / self.speed + free
 
     def frames(self) -> Iterator[Frame]:
         """
         Step the model and yield a frame at t = 0 and at every output tick.
+
+        :attr:`speed` is read at every step, so a caller may change it while
+        iterating (the ROS node does); the number of steps stays as planned.
 
         Raises
         ------

@@ -1,0 +1,53 @@
+# Copyright 2026 The ttb_sim Authors
+#
+# Licensed under the Apache License, Version 2.0 (the "License");
+# you may not use this file except in compliance with the License.
+# You may obtain a copy of the License at
+#
+#     http://www.apache.org/licenses/LICENSE-2.0
+#
+# Unless required by applicable law or agreed to in writing, software
+# distributed under the License is distributed on an "AS IS" BASIS,
+# WITHOUT WARRANTIES OR CONDITIONS OF ANY KIND, either express or implied.
+# See the License for the specific language governing permissions and
+# limitations under the License.
+
+"""Install ttb_sim with pip (`pip install .`) or colcon (ament_python)."""
+
+from glob import glob
+
+from setuptools import find_packages, setup
+
+package_name = 'ttb_sim'
+
+setup(
+    name=package_name,
+    version='0.1.0',
+    packages=find_packages(exclude=['test', 'test.*']),
+    data_files=[
+        ('share/ament_index/resource_index/packages', ['resource/' + package_name]),
+        ('share/' + package_name, ['package.xml']),
+        ('share/' + package_name + '/config', glob('config/*.yaml')),
+        ('share/' + package_name + '/launch', glob('launch/*.py')),
+    ],
+    python_requires='>=3.10',
+    install_requires=['setuptools', 'numpy>=1.24', 'scipy>=1.10', 'rosbags>=0.10',
+                      'PyYAML>=6', 'tqdm>=4.60'],
+    extras_require={
+        'test': ['pytest>=7', 'mcap>=1.1', 'mcap-ros2-support>=0.5', 'flake8>=6',
+                 'flake8-quotes', 'flake8-import-order', 'flake8-builtins',
+                 'flake8-comprehensions', 'flake8-class-newline', 'flake8-blind-except',
+                 'flake8-deprecated', 'flake8-docstrings', 'pydocstyle>=6'],
+    },
+    zip_safe=True,
+    maintainer='ttb_sim maintainers',
+    maintainer_email='maintainers@ttb-sim.invalid',
+    description='Train-track-bridge-pier-cap-pile-soil dynamics with rosbag2 output.',
+    license='Apache-2.0',
+    tests_require=['pytest'],
+    entry_points={
+        'console_scripts': [
+            'ttb-sim = ttb_sim.cli:main',
+        ],
+    },
+)

@@ -1,0 +1,227 @@
+# Copyright 2026 The ttb_sim Authors
+#
+# Licensed under the Apache License, Version 2.0 (the "License");
+# you may not use this file except in compliance with the License.
+# You may obtain a copy of the License at
+#
+#     http://www.apache.org/licenses/LICENSE-2.0
+#
+# Unless required by applicable law or agreed to in writing, software
+# distributed under the License is distributed on an "AS IS" BASIS,
+# WITHOUT WARRANTIES OR CONDITIONS OF ANY KIND, either express or implied.
+# See the License for the specific language governing permissions and
+# limitations under the License.
+
+"""
+The topic table: names, standard ROS 2 message types and frame -> message conversion.
+
+One table serves the offline bag writer (messages built from the rosbags
+typestore) and the live node (messages built from the rclpy classes): a
+conversion receives a ``types`` callable that maps a type name such as
+``'geometry_msgs/msg/Vector3Stamped'`` to a message class, and builds the message
+with keyword arguments named exactly as the ROS fields. Every field is given, so
+the same call works for both back-ends.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any, Callable
+
+import numpy as np
+
+from ttb_sim.sim.frames import Frame, Layout
+
+MessageTypes = Callable[[str], Any]
+"""Maps a ROS type name to its message class."""
+
+FRAME_ID = 'track'
+"""REP 103 track frame: x along the track from its start, y left, z up."""
+NAMESPACE = '/ttb_sim'
+"""Default node namespace of the private topics (node name ``ttb_sim``)."""
+
+_ZERO9 = np.zeros(9)
+_NO_ORIENTATION = np.array([-1.0, 0, 0, 0, 0, 0, 0, 0, 0])  # REP 145: not provided
+
+
+def _time(types: MessageTypes, stamp_ns: int) -> Any:
+    return types('builtin_interfaces/msg/Time')(sec=int(stamp_ns // 1_000_000_000),
+                                                nanosec=int(stamp_ns % 1_000_000_000))
+
+
+def _header(types: MessageTypes, stamp_ns: int) -> Any:
+    return types('std_msgs/msg/Header')(stamp=_time(types, stamp_ns), frame_id=FRAME_ID)
+
+
+def _vector3(types: MessageTypes, xyz: np.ndarray) -> Any:
+    return types('geometry_msgs/msg/Vector3')(x=float(xyz[0]), y=float(xyz[1]),
+                                              z=float(xyz[2]))
+
+
+def build_vector3_stamped(types: MessageTypes, stamp_ns: int, values: np.ndarray) -> Any:
+    """Build ``geometry_msgs/msg/Vector3Stamped`` from (x, y, z)."""
+    return types('geometry_msgs/msg/Vector3Stamped')(header=_header(types, stamp_ns),
+                                                     vector=_vector3(types, values))
+
+
+def build_wrench_stamped(types: MessageTypes, stamp_ns: int, values: np.ndarray) -> Any:
+    """Build ``geometry_msgs/msg/WrenchStamped`` from (fx, fy, fz, tx, ty, tz)."""
+    wrench = types('geometry_msgs/msg/Wrench')(force=_vector3(types, values[:3]),
+                                               torque=_vector3(types, values[3:6]))
+    return types('geometry_msgs/msg/WrenchStamped')(header=_header(types, stamp_ns),
+                                                    wrench=wrench)
+
+
+def build_imu(types: MessageTypes, stamp_ns: int, values: np.ndarray) -> Any:
+    """Build ``sensor_msgs/msg/Imu`` from (ax, ay, az, wx, wy, wz); no orientation."""
+    quaternion = types('geometry_msgs/msg/Quaternion')(x=0.0, y=0.0, z=0.0, w=1.0)
+    return types('sensor_msgs/msg/Imu')(
+        header=_header(types, stamp_ns), orientation=quaternion,
+        orientation_covariance=_NO_ORIENTATION.copy(),
+        angular_velocity=_vector3(types, values[3:6]),
+        angular_velocity_covariance=_ZERO9.copy(),
+        linear_acceleration=_vector3(types, values[:3]),
+        linear_acceleration_covariance=_ZERO9.copy())
+
+
+def build_odometry(types: MessageTypes, stamp_ns: int, values: np.ndarray) -> Any:
+    """Build ``nav_msgs/msg/Odometry`` from (head position x, speed vx)."""
+    point = types('geometry_msgs/msg/Point')(x=float(values[0]), y=0.0, z=0.0)
+    quaternion = types('geometry_msgs/msg/Quaternion')(x=0.0, y=0.0, z=0.0, w=1.0)
+    pose = types('geometry_msgs/msg/Pose')(position=point, orientation=quaternion)
+    twist = types('geometry_msgs/msg/Twist')(
+        linear=_vector3(types, (values[1], 0.0, 0.0)),
+        angular=_vector3(types, (0.0, 0.0, 0.0)))
+    pose_cov = types('geometry_msgs/msg/PoseWithCovariance')(pose=pose,
+                                                             covariance=np.zeros(36))
+    twist_cov = types('geometry_msgs/msg/TwistWithCovariance')(twist=twist,
+                                                               covariance=np.zeros(36))
+    return types('nav_msgs/msg/Odometry')(header=_header(types, stamp_ns),
+                                          child_frame_id='train', pose=pose_cov,
+                                          twist=twist_cov)
+
+
+def build_clock(types: MessageTypes, stamp_ns: int, values: np.ndarray) -> Any:
+    """Build ``rosgraph_msgs/msg/Clock``."""
+    return types('rosgraph_msgs/msg/Clock')(clock=_time(types, stamp_ns))
+
+
+VECTOR3 = ('x', 'y', 'z')
+WRENCH = ('force.x', 'force.y', 'force.z', 'torque.x', 'torque.y', 'torque.z')
+IMU = ('linear_acceleration.x', 'linear_acceleration.y', 'linear_acceleration.z',
+       'angular_velocity.x', 'angular_velocity.y', 'angular_velocity.z')
+
+
+@dataclass(frozen=True)
+class Topic:
+    """
+    One published / recorded topic.
+
+    Attributes
+    ----------
+    name : str
+        Name relative to the node (``bridge/span01/midspan``), or absolute
+        (``/clock``) for global topics.
+    msgtype : str
+        Standard ROS 2 message type.
+    fields : tuple of str
+        Names of the numeric values that ``extract`` returns (for summaries).
+    extract : callable
+        Frame -> numeric values (SI).
+    build : callable
+        (types, stamp_ns, values) -> message.
+    qos : str
+        'sensor' (reliable, keep last 10), 'clock' or 'latched'.
+    unit : str
+        Unit of the values, for documentation.
+
+    """
+
+    name: str
+    msgtype: str
+    fields: tuple[str, ...]
+    extract: Callable[[Frame], np.ndarray]
+    build: Callable[[MessageTypes, int, np.ndarray], Any]
+    qos: str = 'sensor'
+    unit: str = ''
+
+    def full_name(self, namespace: str = NAMESPACE) -> str:
+        """Return the absolute topic name under a node namespace."""
+        return self.name if self.name.startswith('/') else f'{namespace}/{self.name}'
+
+    def message(self, types: MessageTypes, frame: Frame) -> Any:
+        """Convert a frame to this topic's message."""
+        return self.build(types, frame.stamp_ns, self.extract(frame))
+
+
+def topic_table(layout: Layout) -> list[Topic]:
+    """
+    Return the topics a run with this layout produces, in a fixed order.
+
+    Parameters
+    ----------
+    layout : Layout
+        Sizes of the model's outputs.
+
+    Returns
+    -------
+    list of Topic
+
+    """
+    topics = [
+        Topic('/clock', 'rosgraph_msgs/msg/Clock', (), lambda f: np.zeros(0), build_clock,
+              qos='clock', unit='s'),
+        Topic('train/odometry', 'nav_msgs/msg/Odometry',
+              ('pose.pose.position.x', 'twist.twist.linear.x'),
+              lambda f: np.array([f.head_position, f.speed]), build_odometry, unit='m, m/s'),
+    ]
+    for i in range(layout.n_bodies):
+        topics.append(Topic(
+            f'train/car{i + 1:02d}/body/imu', 'sensor_msgs/msg/Imu', IMU,
+            lambda f, i=i: np.concatenate([f.body_acceleration[i],
+                                           f.body_angular_velocity[i]]),
+            build_imu, unit='m/s^2, rad/s'))
+        for s, side in enumerate(('left', 'right')):
+            topics.append(Topic(
+                f'wheel_rail/car{i + 1:02d}/axle1/{side}', 'geometry_msgs/msg/WrenchStamped',
+                WRENCH, lambda f, i=i: np.concatenate([0.5 * f.contact_force[i], np.zeros(3)]),
+                build_wrench_stamped, unit='N'))
+    for k in range(layout.n_spans):
+        topics.append(Topic(f'bridge/span{k + 1:02d}/midspan',
+                            'geometry_msgs/msg/Vector3Stamped', VECTOR3,
+                            lambda f, k=k: f.midspan[k], build_vector3_stamped, unit='m'))
+    for s in range(layout.n_supports):
+        for side_index, side in enumerate(('left', 'right')):
+            topics.append(Topic(
+                f'bearings/pier{s + 1:02d}/{side}', 'geometry_msgs/msg/WrenchStamped', WRENCH,
+                lambda f, s=s, j=side_index: np.concatenate([f.bearings[s, j], np.zeros(3)]),
+                build_wrench_stamped, unit='N'))
+    return topics
+
+
+class PeakTracker:
+    """Running minimum and maximum of every topic's numeric fields."""
+
+    def __init__(self, topics: list[Topic], namespace: str = NAMESPACE) -> None:
+        self._topics = [t for t in topics if t.fields]
+        self._names = [t.full_name(namespace) for t in self._topics]
+        self._lo = [np.full(len(t.fields), np.inf) for t in self._topics]
+        self._hi = [np.full(len(t.fields), -np.inf) for t in self._topics]
+
+    def update(self, frame: Frame) -> None:
+        """Fold one frame into the running extremes."""
+        for i, topic in enumerate(self._topics):
+            values = topic.extract(frame)
+            np.minimum(self._lo[i], values, out=self._lo[i])
+            np.maximum(self._hi[i], values, out=self._hi[i])
+
+    def summary(self) -> dict[str, dict[str, dict[str, float]]]:
+        """Return {topic: {field: {min, max, abs_max}}} (fields never seen are omitted)."""
+        out: dict[str, dict[str, dict[str, float]]] = {}
+        for name, topic, lo, hi in zip(self._names, self._topics, self._lo, self._hi):
+            if not np.all(np.isfinite(lo)):
+                continue
+            out[name] = {f: {'min': float(a), 'max': float(b),
+                             'abs_max': float(max(abs(a), abs(b)))}
+                         for f, a, b in zip(topic.fields, lo, hi)}
+        return out

@@ -1,0 +1,141 @@
+# Copyright 2026 The ttb_sim Authors
+#
+# Licensed under the Apache License, Version 2.0 (the "License");
+# you may not use this file except in compliance with the License.
+# You may obtain a copy of the License at
+#
+#     http://www.apache.org/licenses/LICENSE-2.0
+#
+# Unless required by applicable law or agreed to in writing, software
+# distributed under the License is distributed on an "AS IS" BASIS,
+# WITHOUT WARRANTIES OR CONDITIONS OF ANY KIND, either express or implied.
+# See the License for the specific language governing permissions and
+# limitations under the License.
+
+"""
+Offline runs: a scenario simulated to a rosbag2 directory plus ``summary.json``.
+
+This is the library behind ``ttb-sim run``: it validates everything before it
+creates anything, writes frames as they come, and leaves a closed, readable bag
+and a summary whatever way the run ends (success, divergence, interruption).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+import json
+import logging
+from pathlib import Path
+import time
+from typing import Any, Callable
+
+from ttb_sim import __version__
+from ttb_sim.errors import DivergenceError, ScenarioError
+from ttb_sim.io.bag import BagRecorder, STORAGES
+from ttb_sim.io.topics import PeakTracker, topic_table
+from ttb_sim.scenario import Scenario
+from ttb_sim.sim.simulation import Simulation
+
+log = logging.getLogger(__name__)
+
+
+@dataclass
+class RunResult:
+    """What a run produced."""
+
+    path: Path
+    status: str
+    """'ok', 'diverged' or 'interrupted'."""
+    summary: dict[str, Any]
+
+
+def default_output(name: str, root: Path = Path('runs')) -> Path:
+    """Return a new folder name under ``root`` for a scenario name."""
+    stem = root / f'{name}-{time.strftime("%Y%m%d-%H%M%S")}'
+    path, k = stem, 1
+    while path.exists():
+        k += 1
+        path = stem.with_name(f'{stem.name}-{k}')
+    return path
+
+
+def run_to_bag(scenario: Scenario, out: Path, storage: str = 'mcap',
+               progress: Callable[[int], None] | None = None,
+               simulation: Simulation | None = None) -> RunResult:
+    """
+    Simulate a scenario and record it.
+
+    Parameters
+    ----------
+    scenario : Scenario
+        Validated scenario.
+    out : Path
+        Bag directory to create (must not exist).
+    storage : str
+        'mcap' or 'sqlite3'.
+    progress : callable, optional
+        Called with the number of frames written since the last call.
+    simulation : Simulation, optional
+        An already built simulation of ``scenario``.
+
+    Returns
+    -------
+    RunResult
+        Status 'ok' or 'diverged'.
+
+    Raises
+    ------
+    ScenarioError
+        Before anything is written, for a bad storage or an existing ``out``.
+    KeyboardInterrupt
+        Re-raised after the bag and summary have been closed and written.
+
+    """
+    if storage not in STORAGES:
+        raise ScenarioError(f'--storage {storage!r}: allowed values are '
+                            f'{", ".join(STORAGES)}')
+    out = Path(out)
+    if out.exists():
+        raise ScenarioError(f'output directory {str(out)!r} exists; refusing to overwrite it')
+    sim = simulation or Simulation(scenario)
+    topics = topic_table(sim.layout)
+    peaks = PeakTracker(topics)
+    out.parent.mkdir(parents=True, exist_ok=True)
+    status, message, frames, last_time = 'ok', '', 0, 0.0
+    start = time.perf_counter()
+    try:
+        with BagRecorder(out, topics, storage) as bag:
+            for frame in sim.frames():
+                bag.write(frame)
+                peaks.update(frame)
+                frames += 1
+                last_time = frame.time
+                if progress is not None:
+                    progress(1)
+    except DivergenceError as exc:
+        status, message = 'diverged', str(exc)
+    except KeyboardInterrupt:
+        status, message = 'interrupted', 'interrupted by a signal'
+        raise
+    finally:
+        wall = time.perf_counter() - start
+        summary = {
+            'ttb_sim_version': __version__,
+            'status': status,
+            'message': message,
+            'scenario': scenario.to_dict(),
+            'bag': {'path': str(out), 'storage': storage,
+                    'topics': [t.full_name() for t in topics]},
+            'solver': {'dt': sim.dt, 'steps_planned': sim.n_steps,
+                       'duration_planned': sim.duration, 'free_dofs': sim.structure.n_free,
+                       'output_every_steps': sim.output_every},
+            'frames': frames,
+            'simulated_time': last_time,
+            'wall_time': wall,
+            'real_time_factor': last_time / wall if wall > 0 else None,
+            'peaks': peaks.summary(),
+        }
+        if out.is_dir():
+            (out / 'summary.json').write_text(json.dumps(summary, indent=2) + '\n',
+                                              encoding='utf-8')
+    return RunResult(path=out, status=status, summary=summary)
