@@ -531,6 +531,8 @@ def synthesize(
     for j, layer in enumerate(layers):
         family = get_spectrum(layer.spectrum)
         names = tuple(family.components) if layer.components is None else layer.components
+        if len(set(names)) != len(names):
+            raise ScenarioError(f'{family.name}: a component is listed twice in {names}')
         for name in names:
             comp = family.component(name)
             lo, hi = comp.band(layer.wavelength_min, layer.wavelength_max)
@@ -551,7 +553,8 @@ def synthesize(
     dn = 1.0 / (n_fft * dx)
 
     streams = [s.spawn(len(COMPONENTS)) for s in np.random.SeedSequence(seed).spawn(len(layers))]
-    spectra = np.zeros((len(COMPONENTS), n_half), dtype=complex)
+    # Half-spectra of the track-geometry components, in COMPONENTS order.
+    coefficients = np.zeros((len(COMPONENTS), n_half), dtype=complex)
     for j, comp, lo, hi in parts:
         n_lo, n_hi = 1.0 / hi, 1.0 / lo
         if n_hi > (top + 0.5) * dn:
@@ -569,9 +572,9 @@ def synthesize(
         var = comp.integrate_intervals(lower, np.maximum(upper, lower))
         amplitude = scale * np.sqrt(2.0 * var)
         # irfft(Y)[m] = sum_k |Y_k| (2 / N) cos(2 pi k m / N + arg Y_k) for 0 < k < N/2
-        spectra[c, k] += 0.5 * n_fft * amplitude * np.exp(1j * phases[k])
+        coefficients[c, k] += 0.5 * n_fft * amplitude * np.exp(1j * phases[k])
 
-    vertical, alignment, cross_level, gauge = spectra
+    vertical, alignment, cross_level, gauge = coefficients
     rails = np.stack([vertical + 0.5 * cross_level, vertical - 0.5 * cross_level,
                       alignment + 0.5 * gauge, alignment - 0.5 * gauge])
     wavenumber = 2.0 * math.pi * dn * np.arange(n_half)
