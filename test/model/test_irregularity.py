@@ -147,7 +147,7 @@ def test_short_track_has_the_right_variance_on_average():
     Chinese vertical 2-200 m on a 100 m track (record 1600 m), 400 seeds: the
     ensemble mean of the mean square (no mean removal) estimates the variance.
     Reference: quad of G. Tolerance: 10 % (sampling scatter of a 100 m window
-    of long waves; measured about 2 %).
+    of long waves; measured -1.4 %).
     """
     comp = spectra.SPECTRA['chinese_hsr'].components['vertical']
     squares = [np.mean(irr.synthesize('chinese_hsr', length=100.0, dx=0.5, seed=s,
