@@ -36,12 +36,17 @@ log = logging.getLogger('ttb_sim')
 EXIT_OK, EXIT_FAILURE, EXIT_USAGE = 0, 1, 2
 
 
-class _Terminated(KeyboardInterrupt):
-    """Raised in the main thread when SIGTERM arrives."""
+class _StopFlag:
+    """Signal handler that records SIGINT / SIGTERM for the run loop to poll."""
 
+    def __init__(self) -> None:
+        self.signal: int | None = None
 
-def _on_sigterm(signum: int, frame: object) -> None:
-    raise _Terminated()
+    def __call__(self, signum: int, frame: object) -> None:
+        self.signal = signum
+
+    def __bool__(self) -> bool:
+        return self.signal is not None
 
 
 def _parser() -> argparse.ArgumentParser:
@@ -113,22 +118,23 @@ def _cmd_run(args: argparse.Namespace) -> int:
         from tqdm import tqdm
         bar = tqdm(total=simulation.n_frames, unit='frame', desc=scenario.name,
                    file=sys.stderr, leave=False)
-    previous = signal.signal(signal.SIGTERM, _on_sigterm)
+    stop = _StopFlag()
+    previous = {sig: signal.signal(sig, stop) for sig in (signal.SIGINT, signal.SIGTERM)}
     try:
         result = run_to_bag(scenario, out, args.storage,
                             progress=bar.update if bar is not None else None,
-                            simulation=simulation)
-    except _Terminated:
-        print(f'ttb-sim: terminated; bag closed at {out}', file=sys.stderr)
-        return 128 + signal.SIGTERM
-    except KeyboardInterrupt:
-        print(f'ttb-sim: interrupted; bag closed at {out}', file=sys.stderr)
-        return 128 + signal.SIGINT
+                            simulation=simulation, should_stop=stop.__bool__)
     finally:
-        signal.signal(signal.SIGTERM, previous)
+        for sig, handler in previous.items():
+            signal.signal(sig, handler)
         if bar is not None:
             bar.close()
     s = result.summary
+    if result.status == 'interrupted':
+        name = signal.Signals(stop.signal).name if stop.signal else 'signal'
+        print(f'ttb-sim: stopped by {name}; bag closed at {out} with {s["frames"]} frames',
+              file=sys.stderr)
+        return 128 + (stop.signal or signal.SIGINT)
     if result.status == 'diverged':
         print(f'ttb-sim: failed: {s["message"]}; bag closed at {out} with {s["frames"]} '
               'frames', file=sys.stderr)

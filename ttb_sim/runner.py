@@ -61,7 +61,8 @@ def default_output(name: str, root: Path = Path('runs')) -> Path:
 
 def run_to_bag(scenario: Scenario, out: Path, storage: str = 'mcap',
                progress: Callable[[int], None] | None = None,
-               simulation: Simulation | None = None) -> RunResult:
+               simulation: Simulation | None = None,
+               should_stop: Callable[[], bool] | None = None) -> RunResult:
     """
     Simulate a scenario and record it.
 
@@ -77,11 +78,15 @@ def run_to_bag(scenario: Scenario, out: Path, storage: str = 'mcap',
         Called with the number of frames written since the last call.
     simulation : Simulation, optional
         An already built simulation of ``scenario``.
+    should_stop : callable, optional
+        Polled between frames; when it returns True the run stops cleanly with
+        status 'interrupted' (signal handlers set such a flag, so that no
+        exception ever interrupts a message half-written).
 
     Returns
     -------
     RunResult
-        Status 'ok' or 'diverged'.
+        Status 'ok', 'diverged' or 'interrupted'.
 
     Raises
     ------
@@ -112,6 +117,9 @@ def run_to_bag(scenario: Scenario, out: Path, storage: str = 'mcap',
                 last_time = frame.time
                 if progress is not None:
                     progress(1)
+                if should_stop is not None and should_stop():
+                    status, message = 'interrupted', 'stopped by a signal'
+                    break
     except DivergenceError as exc:
         status, message = 'diverged', str(exc)
     except KeyboardInterrupt:
