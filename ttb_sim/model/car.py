@@ -1,0 +1,913 @@
+# Copyright 2026 The ttb_sim Authors
+#
+# Licensed under the Apache License, Version 2.0 (the "License");
+# you may not use this file except in compliance with the License.
+# You may obtain a copy of the License at
+#
+#     http://www.apache.org/licenses/LICENSE-2.0
+#
+# Unless required by applicable law or agreed to in writing, software
+# distributed under the License is distributed on an "AS IS" BASIS,
+# WITHOUT WARRANTIES OR CONDITIONS OF ANY KIND, either express or implied.
+# See the License for the specific language governing permissions and
+# limitations under the License.
+
+"""
+Build the 42-DOF multibody car of [P] (Table 1) and a train of such cars.
+
+Bodies and degrees of freedom
+-----------------------------
+Seven rigid bodies, six DOF each, body-major ordering
+``index = 6 * body + component``:
+
+======  ================  ==========================================
+body    name              longitudinal position of the centre (m)
+======  ================  ==========================================
+0       ``car_body``      0
+1       ``bogie_1``       +l_c (front bogie)
+2       ``bogie_2``       -l_c (rear bogie)
+3..6    ``wheelset_1..4``  +l_c + l_t, +l_c - l_t, -l_c + l_t, -l_c - l_t
+======  ================  ==========================================
+
+Components: 0 ``x`` (longitudinal), 1 ``y`` (lateral), 2 ``z`` (vertical),
+3 ``roll`` (about x), 4 ``pitch`` (about y), 5 ``yaw`` (about z).
+
+Axes follow REP 103 in the track frame: x forward along the track (direction of
+travel), y to the LEFT, z UP; rotations are right-handed about those axes, so
+a positive pitch lowers the front of a body and a positive roll raises its
+left side.  [P] and Zhai write the vertical equations with z DOWNWARD positive
+(PHYSICS.md section 3); here a vertical displacement is positive upward and
+gravity acts in -z.  All displacements are perturbations about the prescribed
+forward running at speed V; ``x`` is the longitudinal perturbation.
+
+Wheelset spin
+-------------
+The nominal spin of every wheelset is the prescribed rolling rate
+Omega = V / r0 (positive about +y for forward running).  The wheelset
+``pitch`` DOF carries the spin perturbation (rotation angle about the axle on
+top of Omega t), with inertia I_wy.  The axle boxes sit on the axle axis, so
+no suspension element acts on it: it is driven only by the longitudinal creep
+forces at the contacts (through ``-r0 * pitch`` in the contact-point motion,
+see :func:`contact_map`).  The gyroscopic coupling of roll and yaw caused by
+the nominal spin is speed dependent and is provided separately by
+:func:`gyroscopic_matrix` (add it to C for a given speed).
+
+Suspension layout and element counts (per car)
+----------------------------------------------
+* Primary: one spring at each of the 8 axle boxes (PHYSICS.md section 3.1),
+  at lateral offset +/-``primary_semi_spacing`` on the axle axis, with Table 1
+  per-spring stiffnesses K_px, K_py, K_pz.
+* Secondary: one air spring at each of the 4 positions (2 per bogie), at
+  +/-``secondary_semi_spacing`` and height ``secondary_height``, with per-spring
+  stiffnesses K_sx, K_sy, K_sz.
+* Dampers (Table 1 gives only C_pz, C_sy, C_sz): by default one damper per
+  spring position, i.e. 8 primary vertical, 4 secondary vertical and
+  4 secondary lateral dampers per car, each with the Table 1 coefficient.
+  Reason: [P] builds on Zhai's equations (PHYSICS.md section 3), which write
+  the suspension force of each bogie side pair as 2 K (...) + 2 C (...)', i.e.
+  with the same multiplicity for dampers and springs; [P] gives no other count.
+  This reproduces that model literally, but it is heavily damped.  With the
+  wheelsets fixed, the damping ratios of the undamped vertical modes
+  (projection phi^T C phi / 2 omega, :func:`modal_damping_ratios`) are 0.56
+  car-body bounce, 0.63 car-body pitch, 0.65 bogie pitch and 1.52 bogie
+  bounce; PHYSICS.md's secondary-only estimate is 0.71.  The complex
+  eigenvalues of the damped system give car-body bounce |lambda| = 0.96 Hz,
+  zeta = 0.57 (damped 0.79 Hz) and over-damped bogie bounce, because the
+  dampers stiffen the primary-secondary series.  Reading the Table 1 values
+  as per-bogie totals (4 / 2 / 2 dampers) halves the projected ratios
+  (0.28, 0.32, 0.33, 0.76; damped bounce 0.82 Hz).  The counts are parameters
+  (``n_*_dampers``); dampers are smeared evenly over the spring
+  positions, so any count keeps the left/right and front/rear symmetry.
+
+Documented assumptions (not given in [P])
+-----------------------------------------
+Heights above the rail top: car-body centre of gravity 1.70 m, secondary
+suspension force plane 0.90 m, bogie frame centre of gravity at axle height
+(0.46 m), wheelset centre at r0.  Lateral semi-spacings: primary springs
+1.00 m, secondary springs 1.00 m.  These are typical high-speed-car values;
+they set the lateral-roll coupling.  By default the longitudinal suspension
+forces have no pitch moment arm (``longitudinal_pitch_coupling=False``), as
+in Zhai's model, whose pitch equations contain vertical forces only; this
+keeps the vertical in-plane modes those of PHYSICS.md 3.1.  With the physical
+arms (``True``) car-body and bogie pitch rise by about 0.8 %.
+
+Zero-stiffness modes of the free car (wheelsets not in contact): 6 rigid-body
+motions, 4 wheelset spins and 2 mechanisms in which each bogie rocks in
+pitch, together with its two wheelsets, about the lateral line through its
+two air springs (the secondary suspension sits at the bogie centre).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, fields
+import math
+from typing import Sequence
+
+import numpy as np
+import scipy.linalg
+import scipy.sparse
+
+from ttb_sim.errors import ScenarioError
+
+#: Standard gravity used for the gravity loads (m/s^2).
+GRAVITY = 9.81
+
+#: Names of the seven bodies, in DOF order.
+BODY_NAMES = ('car_body', 'bogie_1', 'bogie_2',
+              'wheelset_1', 'wheelset_2', 'wheelset_3', 'wheelset_4')
+
+#: Names of the six components of each body, in DOF order.
+COMPONENTS = ('x', 'y', 'z', 'roll', 'pitch', 'yaw')
+
+N_BODIES = 7
+DOF_PER_BODY = 6
+N_DOF = N_BODIES * DOF_PER_BODY
+
+CAR_BODY = 0
+BOGIES = (1, 2)
+WHEELSETS = (3, 4, 5, 6)
+
+#: Sides of the wheels, in contact order: left (+1, y > 0) then right (-1).
+SIDES = (1, -1)
+
+
+def _index(names: Sequence[str], key: int | str, what: str) -> int:
+    if isinstance(key, str):
+        if key not in names:
+            msg = f'{what} {key!r} is unknown; allowed: {", ".join(names)}'
+            raise ScenarioError(msg)
+        return names.index(key)
+    value = int(key)
+    if not 0 <= value < len(names):
+        msg = f'{what} index {key} is out of range; allowed: 0..{len(names) - 1}'
+        raise ScenarioError(msg)
+    return value
+
+
+def dof(body: int | str, component: int | str) -> int:
+    """
+    Return the index of one DOF in the 42-vector of a car.
+
+    Parameters
+    ----------
+    body : int or str
+        Body index 0..6 or name from :data:`BODY_NAMES`.
+    component : int or str
+        Component index 0..5 or name from :data:`COMPONENTS`.
+
+    Returns
+    -------
+    int
+        ``6 * body + component``.
+
+    Raises
+    ------
+    ScenarioError
+        If the body or component is unknown.
+
+    """
+    return (DOF_PER_BODY * _index(BODY_NAMES, body, 'body')
+            + _index(COMPONENTS, component, 'component'))
+
+
+def dofs(bodies: Sequence[int | str], components: Sequence[int | str]) -> np.ndarray:
+    """
+    Return the DOF indices of every (body, component) pair, body-major.
+
+    Parameters
+    ----------
+    bodies : sequence of int or str
+        Bodies (indices or names).
+    components : sequence of int or str
+        Components (indices or names).
+
+    Returns
+    -------
+    numpy.ndarray
+        Integer array of ``len(bodies) * len(components)`` indices.
+
+    """
+    return np.array([dof(b, c) for b in bodies for c in components], dtype=int)
+
+
+def wheelset_dofs(j: int) -> np.ndarray:
+    """
+    Return the six DOF indices of wheelset ``j`` (0..3, front to rear).
+
+    Parameters
+    ----------
+    j : int
+        Wheelset number within the car, 0 = leading axle.
+
+    Returns
+    -------
+    numpy.ndarray
+        Indices of x, y, z, roll, pitch (spin perturbation), yaw.
+
+    """
+    if not 0 <= int(j) < 4:
+        raise ScenarioError(f'wheelset number {j} is out of range; allowed: 0..3')
+    return dofs([WHEELSETS[int(j)]], COMPONENTS)
+
+
+@dataclass(frozen=True)
+class CarParameters:
+    """
+    Parameters of one car; defaults are [P] Table 1 plus documented assumptions.
+
+    Units are SI: masses kg, inertias kg m^2, stiffness per spring N/m,
+    damping per damper N s/m, lengths m.  Stiffness and damping values are per
+    element; the element counts are fixed for springs (8 axle boxes, 4 air
+    springs) and given by the ``n_*_dampers`` fields for dampers.
+    """
+
+    car_body_mass: float = 48000.0
+    bogie_mass: float = 3200.0
+    wheelset_mass: float = 2400.0
+    car_body_roll_inertia: float = 1.15e5
+    car_body_pitch_inertia: float = 2.3e6
+    car_body_yaw_inertia: float = 2.3e6
+    bogie_roll_inertia: float = 3200.0
+    bogie_pitch_inertia: float = 7200.0
+    bogie_yaw_inertia: float = 6800.0
+    wheelset_roll_inertia: float = 1200.0
+    wheelset_pitch_inertia: float = 200.0
+    wheelset_yaw_inertia: float = 1200.0
+    primary_stiffness_x: float = 9.0e6
+    primary_stiffness_y: float = 3.0e6
+    primary_stiffness_z: float = 1.04e6
+    secondary_stiffness_x: float = 0.24e6
+    secondary_stiffness_y: float = 0.24e6
+    secondary_stiffness_z: float = 0.4e6
+    primary_damping_z: float = 45.0e3
+    secondary_damping_y: float = 3.0e3
+    secondary_damping_z: float = 98.0e3
+    n_primary_vertical_dampers: int = 8
+    n_secondary_vertical_dampers: int = 4
+    n_secondary_lateral_dampers: int = 4
+    bogie_semi_distance: float = 7.85
+    axle_semi_distance: float = 1.25
+    wheel_radius: float = 0.46
+    contact_semi_distance: float = 0.7465
+    primary_semi_spacing: float = 1.0
+    secondary_semi_spacing: float = 1.0
+    car_body_cg_height: float = 1.70
+    secondary_height: float = 0.90
+    bogie_cg_height: float = 0.46
+    longitudinal_pitch_coupling: bool = False
+
+    def __post_init__(self) -> None:
+        positive = {f.name for f in fields(self)} - {
+            'n_primary_vertical_dampers', 'n_secondary_vertical_dampers',
+            'n_secondary_lateral_dampers', 'longitudinal_pitch_coupling'}
+        if not isinstance(self.longitudinal_pitch_coupling, bool):
+            msg = ('car parameter longitudinal_pitch_coupling = '
+                   f'{self.longitudinal_pitch_coupling!r} is invalid; allowed: true or false')
+            raise ScenarioError(msg)
+        for name in sorted(positive):
+            value = getattr(self, name)
+            if not (isinstance(value, (int, float)) and math.isfinite(value) and value > 0.0):
+                msg = f'car parameter {name} = {value!r} is invalid; allowed: finite and > 0'
+                raise ScenarioError(msg)
+        for name in ('n_primary_vertical_dampers', 'n_secondary_vertical_dampers',
+                     'n_secondary_lateral_dampers'):
+            value = getattr(self, name)
+            if isinstance(value, bool) or not isinstance(value, int) or not 0 <= value <= 64:
+                msg = f'car parameter {name} = {value!r} is invalid; allowed: integer 0..64'
+                raise ScenarioError(msg)
+        if self.axle_semi_distance >= self.bogie_semi_distance:
+            msg = (f'car parameter axle_semi_distance = {self.axle_semi_distance!r} is '
+                   f'invalid; allowed: < bogie_semi_distance ({self.bogie_semi_distance})')
+            raise ScenarioError(msg)
+        if self.wheel_radius >= self.axle_semi_distance:
+            msg = (f'car parameter wheel_radius = {self.wheel_radius!r} is invalid; '
+                   f'allowed: < axle_semi_distance ({self.axle_semi_distance})')
+            raise ScenarioError(msg)
+
+    @property
+    def static_wheel_load(self) -> float:
+        """Static wheel load P0 = (Mc/8 + Mt/4 + Mw/2) g (N)."""
+        return static_wheel_load(self)
+
+    @property
+    def total_mass(self) -> float:
+        """Total mass of the car, Mc + 2 Mt + 4 Mw (kg)."""
+        return self.car_body_mass + 2.0 * self.bogie_mass + 4.0 * self.wheelset_mass
+
+
+def static_wheel_load(params: CarParameters | None = None) -> float:
+    """
+    Return the static wheel load P0 = (Mc/8 + Mt/4 + Mw/2) g.
+
+    Parameters
+    ----------
+    params : CarParameters, optional
+        Car parameters; Table 1 defaults if omitted.
+
+    Returns
+    -------
+    float
+        P0 in N (78.48 kN for Table 1).
+
+    """
+    p = params or CarParameters()
+    return (p.car_body_mass / 8.0 + p.bogie_mass / 4.0 + p.wheelset_mass / 2.0) * GRAVITY
+
+
+def body_positions(params: CarParameters | None = None) -> np.ndarray:
+    """
+    Return the centre of gravity of each body in the car frame.
+
+    Parameters
+    ----------
+    params : CarParameters, optional
+        Car parameters; Table 1 defaults if omitted.
+
+    Returns
+    -------
+    numpy.ndarray
+        Shape (7, 3): x (m, forward from the car centre), y (0) and z (m, height
+        above the rail top) of each body, in DOF order.
+
+    """
+    p = params or CarParameters()
+    lc, lt = p.bogie_semi_distance, p.axle_semi_distance
+    x = np.array([0.0, lc, -lc, lc + lt, lc - lt, -lc + lt, -lc - lt])
+    z = np.array([p.car_body_cg_height, p.bogie_cg_height, p.bogie_cg_height]
+                 + [p.wheel_radius] * 4)
+    return np.column_stack([x, np.zeros(N_BODIES), z])
+
+
+def mass_matrix(params: CarParameters | None = None) -> np.ndarray:
+    """
+    Return the constant 42 x 42 diagonal mass matrix (kg, kg m^2).
+
+    Parameters
+    ----------
+    params : CarParameters, optional
+        Car parameters; Table 1 defaults if omitted.
+
+    Returns
+    -------
+    numpy.ndarray
+        Diagonal matrix with [m, m, m, I_xx, I_yy, I_zz] per body.
+
+    """
+    p = params or CarParameters()
+    diag = np.array([
+        [p.car_body_mass] * 3 + [p.car_body_roll_inertia, p.car_body_pitch_inertia,
+                                 p.car_body_yaw_inertia],
+        *([[p.bogie_mass] * 3 + [p.bogie_roll_inertia, p.bogie_pitch_inertia,
+                                 p.bogie_yaw_inertia]] * 2),
+        *([[p.wheelset_mass] * 3 + [p.wheelset_roll_inertia, p.wheelset_pitch_inertia,
+                                    p.wheelset_yaw_inertia]] * 4),
+    ])
+    return np.diag(diag.ravel())
+
+
+@dataclass(frozen=True)
+class SuspensionElements:
+    """
+    Every suspension connection of a car as point-to-point 3-D spring-dampers.
+
+    Attributes
+    ----------
+    body_a, body_b : numpy.ndarray
+        Shape (n,), the two bodies each element connects.
+    point : numpy.ndarray
+        Shape (n, 3), attachment point (x, y, z) in the car frame (m); both
+        bodies are attached there.
+    stiffness : numpy.ndarray
+        Shape (n, 3), stiffness along x, y, z (N/m).
+    damping : numpy.ndarray
+        Shape (n, 3), damping along x, y, z (N s/m), already multiplied by the
+        number of dampers per position.
+    group : tuple of str
+        Name of the spring group of each element.
+
+    """
+
+    body_a: np.ndarray
+    body_b: np.ndarray
+    point: np.ndarray
+    stiffness: np.ndarray
+    damping: np.ndarray
+    group: tuple[str, ...]
+
+
+def suspension_elements(params: CarParameters | None = None) -> SuspensionElements:
+    """
+    Return the 8 primary and 4 secondary suspension elements of a car.
+
+    Parameters
+    ----------
+    params : CarParameters, optional
+        Car parameters; Table 1 defaults if omitted.
+
+    Returns
+    -------
+    SuspensionElements
+        Primary elements connect bogie i to its wheelsets at the axle boxes
+        (on the axle axis, so wheelset spin is not restrained); secondary
+        elements connect the car body to each bogie at the air springs.
+
+    """
+    p = params or CarParameters()
+    pos = body_positions(p)
+    body_a, body_b, point, stiff, damp, group = [], [], [], [], [], []
+    # Dampers smeared evenly over the spring positions (8 axle boxes, 4 air springs).
+    c_pz = p.primary_damping_z * p.n_primary_vertical_dampers / 8.0
+    c_sz = p.secondary_damping_z * p.n_secondary_vertical_dampers / 4.0
+    c_sy = p.secondary_damping_y * p.n_secondary_lateral_dampers / 4.0
+    for i, bogie in enumerate(BOGIES):
+        for side in SIDES:
+            body_a.append(CAR_BODY)
+            body_b.append(bogie)
+            point.append((pos[bogie, 0], side * p.secondary_semi_spacing, p.secondary_height))
+            stiff.append((p.secondary_stiffness_x, p.secondary_stiffness_y,
+                          p.secondary_stiffness_z))
+            damp.append((0.0, c_sy, c_sz))
+            group.append('secondary')
+        for wheelset in WHEELSETS[2 * i:2 * i + 2]:
+            for side in SIDES:
+                body_a.append(bogie)
+                body_b.append(wheelset)
+                point.append((pos[wheelset, 0], side * p.primary_semi_spacing, p.wheel_radius))
+                stiff.append((p.primary_stiffness_x, p.primary_stiffness_y,
+                              p.primary_stiffness_z))
+                damp.append((0.0, 0.0, c_pz))
+                group.append('primary')
+    return SuspensionElements(np.array(body_a), np.array(body_b), np.array(point, dtype=float),
+                              np.array(stiff, dtype=float), np.array(damp, dtype=float),
+                              tuple(group))
+
+
+def point_motion_matrix(bodies: np.ndarray, offsets: np.ndarray,
+                        n_dof: int = N_DOF) -> np.ndarray:
+    """
+    Return the matrices mapping car DOFs to the motion of material points.
+
+    For a point at offset r from the centre of gravity of its body, the small
+    displacement is u + theta x r, i.e. [I | -skew(r)] [u; theta].
+
+    Parameters
+    ----------
+    bodies : numpy.ndarray
+        Shape (n,), body index of each point.
+    offsets : numpy.ndarray
+        Shape (n, 3), offset r of each point from its body's centre (m).
+    n_dof : int
+        Length of the DOF vector (42 for one car).
+
+    Returns
+    -------
+    numpy.ndarray
+        Shape (n, 3, n_dof); row k of block i gives the displacement of point i
+        along axis k (x, y, z).
+
+    """
+    bodies = np.asarray(bodies, dtype=int)
+    r = np.asarray(offsets, dtype=float)
+    n = bodies.size
+    block = np.zeros((n, 3, 6))
+    block[:, :, :3] = np.eye(3)
+    rx, ry, rz = r[:, 0], r[:, 1], r[:, 2]
+    # -skew(r): rows x, y, z; columns roll, pitch, yaw.
+    block[:, 0, 4], block[:, 0, 5] = rz, -ry
+    block[:, 1, 3], block[:, 1, 5] = -rz, rx
+    block[:, 2, 3], block[:, 2, 4] = ry, -rx
+    out = np.zeros((n, 3, n_dof))
+    cols = DOF_PER_BODY * bodies[:, None] + np.arange(6)[None, :]
+    out[np.arange(n)[:, None, None], np.arange(3)[None, :, None], cols[:, None, :]] = block
+    return out
+
+
+def _relative_motion(params: CarParameters, elements: SuspensionElements) -> np.ndarray:
+    pos = body_positions(params)
+    ta = point_motion_matrix(elements.body_a, elements.point - pos[elements.body_a])
+    tb = point_motion_matrix(elements.body_b, elements.point - pos[elements.body_b])
+    t = ta - tb
+    if not params.longitudinal_pitch_coupling:
+        # Zhai-type model: longitudinal suspension forces have no pitch moment arm.
+        t[:, 0, dofs(range(N_BODIES), ['pitch'])] = 0.0
+    return t
+
+
+def stiffness_matrix(params: CarParameters | None = None) -> np.ndarray:
+    """
+    Return the constant 42 x 42 suspension stiffness matrix (N/m, N m/rad).
+
+    Assembled as sum over elements of T^T diag(k) T, where T maps the DOFs to
+    the relative displacement of the element's two ends.
+
+    Parameters
+    ----------
+    params : CarParameters, optional
+        Car parameters; Table 1 defaults if omitted.
+
+    Returns
+    -------
+    numpy.ndarray
+        Symmetric, positive semi-definite; its null space is the rigid motion of
+        the whole car (6) plus the spin of each wheelset (4).
+
+    """
+    p = params or CarParameters()
+    el = suspension_elements(p)
+    t = _relative_motion(p, el)
+    return np.einsum('nai,na,naj->ij', t, el.stiffness, t)
+
+
+def damping_matrix(params: CarParameters | None = None) -> np.ndarray:
+    """
+    Return the constant 42 x 42 suspension damping matrix (N s/m, N m s/rad).
+
+    Parameters
+    ----------
+    params : CarParameters, optional
+        Car parameters; Table 1 defaults if omitted.
+
+    Returns
+    -------
+    numpy.ndarray
+        Symmetric, positive semi-definite; excludes the speed-dependent
+        gyroscopic terms (see :func:`gyroscopic_matrix`) and all contact terms.
+
+    """
+    p = params or CarParameters()
+    el = suspension_elements(p)
+    t = _relative_motion(p, el)
+    return np.einsum('nai,na,naj->ij', t, el.damping, t)
+
+
+def gyroscopic_matrix(params: CarParameters | None, speed: float) -> np.ndarray:
+    """
+    Return the skew-symmetric gyroscopic matrix of the spinning wheelsets.
+
+    With the nominal spin Omega = V / r0 about +y, the roll and yaw equations
+    of each wheelset gain I_wy Omega (-yaw', +roll') terms.
+
+    Parameters
+    ----------
+    params : CarParameters or None
+        Car parameters; Table 1 defaults if None.
+    speed : float
+        Train speed V (m/s), >= 0.
+
+    Returns
+    -------
+    numpy.ndarray
+        42 x 42 matrix G to be added to the damping matrix (G = -G^T).
+
+    """
+    p = params or CarParameters()
+    if not (math.isfinite(speed) and speed >= 0.0):
+        raise ScenarioError(f'speed = {speed!r} m/s is invalid; allowed: finite and >= 0')
+    h = p.wheelset_pitch_inertia * speed / p.wheel_radius
+    g = np.zeros((N_DOF, N_DOF))
+    for w in WHEELSETS:
+        roll, yaw = dof(w, 'roll'), dof(w, 'yaw')
+        g[roll, yaw] = -h
+        g[yaw, roll] = h
+    return g
+
+
+def gravity_vector(params: CarParameters | None = None) -> np.ndarray:
+    """
+    Return the gravity load vector (N), -m g on each vertical DOF (z up).
+
+    Parameters
+    ----------
+    params : CarParameters, optional
+        Car parameters; Table 1 defaults if omitted.
+
+    Returns
+    -------
+    numpy.ndarray
+        Shape (42,).
+
+    """
+    m = np.diag(mass_matrix(params))
+    f = np.zeros(N_DOF)
+    z = dofs(range(N_BODIES), ['z'])
+    f[z] = -m[z] * GRAVITY
+    return f
+
+
+@dataclass(frozen=True)
+class ContactMap:
+    """
+    Kinematics of the 8 wheel-rail contact points of a car.
+
+    Contact k belongs to wheelset ``wheelset[k]`` (0..3) and side ``side[k]``
+    (+1 left, -1 right); order: wheelset 0 left, wheelset 0 right, wheelset 1
+    left, ...  The contact point sits at (0, s b, -r0) from the wheelset centre.
+    Its rigid-body displacement (of the wheel material) is
+
+    * longitudinal: x_w - r0 pitch_w - s b yaw_w  (rows of ``hx``),
+    * lateral:      y_w + r0 roll_w               (rows of ``hy``),
+    * vertical:     z_w + s b roll_w              (rows of ``hz``),
+
+    and ``hyaw`` selects yaw_w (the DOF on which the spin moment M_z acts).
+    The generalised car force from contact forces (Fx, Fy, Fz, Mz) acting on
+    the wheels is ``hx.T @ Fx + hy.T @ Fy + hz.T @ Fz + hyaw.T @ Mz``.  The
+    velocity form of the same rows gives the creepage terms of
+    :func:`ttb_sim.model.contact.creepages`.  The simplified map of PHYSICS.md
+    (lateral motion y_w only) is ``hy`` without the r0 roll term.
+
+    Attributes
+    ----------
+    wheelset, side : numpy.ndarray
+        Shape (8,) integer arrays.
+    x_offset : numpy.ndarray
+        Shape (8,), longitudinal position of the contact relative to the car
+        centre (m, forward positive).
+    hx, hy, hz, hyaw : numpy.ndarray
+        Shape (8, 42) maps (m per unit DOF).
+    semi_distance, wheel_radius : float
+        b and r0 used (m).
+
+    """
+
+    wheelset: np.ndarray
+    side: np.ndarray
+    x_offset: np.ndarray
+    hx: np.ndarray
+    hy: np.ndarray
+    hz: np.ndarray
+    hyaw: np.ndarray
+    semi_distance: float
+    wheel_radius: float
+
+
+def contact_map(params: CarParameters | None = None) -> ContactMap:
+    """
+    Return the wheelset-to-contact kinematics of a car (see :class:`ContactMap`).
+
+    Parameters
+    ----------
+    params : CarParameters, optional
+        Car parameters; Table 1 defaults if omitted.
+
+    Returns
+    -------
+    ContactMap
+        The 8 contacts, ordered wheelset-major, left before right.
+
+    """
+    p = params or CarParameters()
+    b, r0 = p.contact_semi_distance, p.wheel_radius
+    wheelset = np.repeat(np.arange(4), 2)
+    side = np.tile(np.array(SIDES), 4)
+    bodies = np.array(WHEELSETS)[wheelset]
+    offsets = np.column_stack([np.zeros(8), side * b, np.full(8, -r0)])
+    t = point_motion_matrix(bodies, offsets)
+    hyaw = np.zeros((8, N_DOF))
+    hyaw[np.arange(8), DOF_PER_BODY * bodies + 5] = 1.0
+    x_offset = body_positions(p)[bodies, 0]
+    return ContactMap(wheelset, side, x_offset, t[:, 0], t[:, 1], t[:, 2], hyaw, b, r0)
+
+
+def contact_spring_stiffness(cmap: ContactMap, vertical: float, lateral: float = 0.0,
+                             longitudinal: float = 0.0) -> np.ndarray:
+    """
+    Return the stiffness of linear springs from each contact point to a rigid rail.
+
+    This is the linearised rigid-track idealisation used for static and modal
+    checks (e.g. ``vertical`` = the linearised Hertz stiffness k_H).
+
+    Parameters
+    ----------
+    cmap : ContactMap
+        Contact kinematics from :func:`contact_map`.
+    vertical, lateral, longitudinal : float
+        Spring stiffness per contact along z, y, x (N/m), >= 0.
+
+    Returns
+    -------
+    numpy.ndarray
+        42 x 42 symmetric stiffness matrix.
+
+    """
+    for name, value in (('vertical', vertical), ('lateral', lateral),
+                        ('longitudinal', longitudinal)):
+        if not (math.isfinite(value) and value >= 0.0):
+            raise ScenarioError(f'contact spring {name} = {value!r} N/m is invalid; '
+                                'allowed: finite and >= 0')
+    return (vertical * cmap.hz.T @ cmap.hz + lateral * cmap.hy.T @ cmap.hy
+            + longitudinal * cmap.hx.T @ cmap.hx)
+
+
+@dataclass(frozen=True)
+class CarMatrices:
+    """
+    Constant matrices of one car.
+
+    Attributes
+    ----------
+    mass, damping, stiffness : numpy.ndarray
+        42 x 42 matrices (SI).
+    gravity : numpy.ndarray
+        Gravity load vector (N), shape (42,).
+    contacts : ContactMap
+        Wheelset-to-contact kinematics.
+    params : CarParameters
+        The parameters used.
+
+    """
+
+    mass: np.ndarray
+    damping: np.ndarray
+    stiffness: np.ndarray
+    gravity: np.ndarray
+    contacts: ContactMap
+    params: CarParameters
+
+
+def car_matrices(params: CarParameters | None = None) -> CarMatrices:
+    """
+    Build M, C, K, the gravity vector and the contact map of one car.
+
+    Parameters
+    ----------
+    params : CarParameters, optional
+        Car parameters; Table 1 defaults if omitted.
+
+    Returns
+    -------
+    CarMatrices
+        Everything the coupled solver needs from the car.
+
+    """
+    p = params or CarParameters()
+    return CarMatrices(mass_matrix(p), damping_matrix(p), stiffness_matrix(p),
+                       gravity_vector(p), contact_map(p), p)
+
+
+def eigenfrequencies(
+        mass: np.ndarray, stiffness: np.ndarray,
+        subset: Sequence[int] | np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """
+    Return undamped eigenfrequencies and modes of a DOF subset.
+
+    DOFs outside ``subset`` are held fixed (e.g. pass the vertical DOFs of the
+    car body and bogies to get the modes with the wheelsets fixed).
+
+    Parameters
+    ----------
+    mass, stiffness : numpy.ndarray
+        Full square matrices.
+    subset : sequence of int, optional
+        DOF indices kept free; all DOFs if omitted.
+
+    Returns
+    -------
+    frequencies : numpy.ndarray
+        Ascending frequencies (Hz); tiny negative eigenvalues are clipped to 0.
+    modes : numpy.ndarray
+        Shape (n_dof, n_subset): mass-normalised mode shapes expanded to the
+        full DOF vector (zeros on held DOFs), column i for frequency i.
+
+    """
+    n = mass.shape[0]
+    idx = np.arange(n) if subset is None else np.asarray(subset, dtype=int)
+    k = stiffness[np.ix_(idx, idx)]
+    m = mass[np.ix_(idx, idx)]
+    lam, vec = scipy.linalg.eigh(0.5 * (k + k.T), 0.5 * (m + m.T))
+    freq = np.sqrt(np.clip(lam, 0.0, None)) / (2.0 * math.pi)
+    modes = np.zeros((n, idx.size))
+    modes[idx] = vec
+    return freq, modes
+
+
+def modal_damping_ratios(
+        mass: np.ndarray, damping: np.ndarray, stiffness: np.ndarray,
+        subset: Sequence[int] | np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """
+    Return damping ratios of the undamped modes, zeta_i = phi_i^T C phi_i / (2 omega_i).
+
+    This projection neglects the coupling of modes by non-proportional
+    damping; it is the usual way to quote a suspension's damping ratio.
+
+    Parameters
+    ----------
+    mass, damping, stiffness : numpy.ndarray
+        Full square matrices.
+    subset : sequence of int, optional
+        DOF indices kept free (others held fixed).
+
+    Returns
+    -------
+    frequencies : numpy.ndarray
+        Undamped frequencies (Hz), ascending.
+    ratios : numpy.ndarray
+        Damping ratio per mode (-); NaN for zero-frequency modes.
+
+    """
+    freq, modes = eigenfrequencies(mass, stiffness, subset)
+    omega = 2.0 * math.pi * freq
+    proj = np.einsum('ij,ik,kj->j', modes, damping, modes)
+    with np.errstate(divide='ignore', invalid='ignore'):
+        ratios = np.where(omega > 0.0, proj / (2.0 * omega), np.nan)
+    return freq, ratios
+
+
+@dataclass(frozen=True)
+class TrainMatrices:
+    """
+    Block-diagonal matrices of a train of identical, uncoupled cars.
+
+    Cars are not connected (no couplers are modelled); car k (0 = leading car)
+    occupies DOFs 42 k .. 42 k + 41 in the per-car order of this module.
+
+    Attributes
+    ----------
+    mass, damping, stiffness : scipy.sparse.csr_matrix
+        Shape (42 n, 42 n).
+    gravity : numpy.ndarray
+        Shape (42 n,), N.
+    hx, hy, hz, hyaw : scipy.sparse.csr_matrix
+        Shape (8 n, 42 n): contact maps of all cars stacked (contact 8 k + i is
+        contact i of car k, see :class:`ContactMap`).
+    wheelset_x : numpy.ndarray
+        Shape (4 n,): longitudinal position of every wheelset relative to the
+        head of the train (front end of car 0), m, negative behind the head,
+        in DOF order.
+    contact_x : numpy.ndarray
+        Shape (8 n,): the same for every contact.
+    contact_side : numpy.ndarray
+        Shape (8 n,): +1 left, -1 right.
+    n_cars : int
+        Number of cars.
+    car_length : float
+        Length over couplers of each car (m).
+
+    """
+
+    mass: scipy.sparse.csr_matrix
+    damping: scipy.sparse.csr_matrix
+    stiffness: scipy.sparse.csr_matrix
+    gravity: np.ndarray
+    hx: scipy.sparse.csr_matrix
+    hy: scipy.sparse.csr_matrix
+    hz: scipy.sparse.csr_matrix
+    hyaw: scipy.sparse.csr_matrix
+    wheelset_x: np.ndarray
+    contact_x: np.ndarray
+    contact_side: np.ndarray
+    n_cars: int
+    car_length: float
+
+
+def train_matrices(params: CarParameters | None = None, n_cars: int = 8,
+                   car_length: float = 25.0) -> TrainMatrices:
+    """
+    Build the stacked matrices of ``n_cars`` identical cars in a row.
+
+    Parameters
+    ----------
+    params : CarParameters, optional
+        Car parameters; Table 1 defaults if omitted.
+    n_cars : int
+        Number of cars, 1..64 (default 8).
+    car_length : float
+        Length of each car (m), at least 2 (l_c + l_t + r0) so that wheels of
+        neighbouring cars do not overlap (default 25 m).
+
+    Returns
+    -------
+    TrainMatrices
+        Sparse block-diagonal M, C, K, stacked contact maps and positions.
+
+    Raises
+    ------
+    ScenarioError
+        If ``n_cars`` or ``car_length`` is out of range.
+
+    """
+    p = params or CarParameters()
+    if isinstance(n_cars, bool) or not isinstance(n_cars, (int, np.integer)) \
+            or not 1 <= n_cars <= 64:
+        raise ScenarioError(f'train n_cars = {n_cars!r} is invalid; allowed: integer 1..64')
+    min_length = 2.0 * (p.bogie_semi_distance + p.axle_semi_distance + p.wheel_radius)
+    if not (math.isfinite(car_length) and min_length <= car_length <= 100.0):
+        msg = (f'train car_length = {car_length!r} m is invalid; '
+               f'allowed: {min_length:.3f}..100 m')
+        raise ScenarioError(msg)
+    car = car_matrices(p)
+    cm = car.contacts
+    eye = scipy.sparse.identity(n_cars, format='csr')
+
+    def stack(a: np.ndarray) -> scipy.sparse.csr_matrix:
+        return scipy.sparse.kron(eye, scipy.sparse.csr_matrix(a), format='csr')
+
+    centres = -(np.arange(n_cars) + 0.5) * car_length
+    ws_x = body_positions(p)[list(WHEELSETS), 0]
+    return TrainMatrices(
+        mass=stack(car.mass), damping=stack(car.damping), stiffness=stack(car.stiffness),
+        gravity=np.tile(car.gravity, n_cars),
+        hx=stack(cm.hx), hy=stack(cm.hy), hz=stack(cm.hz), hyaw=stack(cm.hyaw),
+        wheelset_x=(centres[:, None] + ws_x[None, :]).ravel(),
+        contact_x=(centres[:, None] + cm.x_offset[None, :]).ravel(),
+        contact_side=np.tile(cm.side, n_cars),
+        n_cars=int(n_cars), car_length=float(car_length))
