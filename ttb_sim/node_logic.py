@@ -480,8 +480,8 @@ class PassageController:
             self.values[name] = value
             if name == 'train.speed_kmh':
                 self.sim.speed = value / 3.6
-            elif name == 'real_time_factor':
-                self._anchor = None
+            elif name == 'real_time_factor':   # the new pace counts from now
+                self._anchor = (self._clock(), self._node_time)
             elif name == 'publish_rate_hz':
                 self._next_publish = self._node_time
             elif name == 'loop' and value and self.state == 'idle':
@@ -506,7 +506,7 @@ class PassageController:
             if self.state in ('idle', 'diverged', 'stopped'):
                 return f'nothing to {"pause" if paused else "resume"}: {self.state}'
             self.state = 'paused' if paused else 'running'
-            self._anchor = None
+            self._anchor = None if paused else (self._clock(), self._node_time)
             return f'{self.state} at t = {self._node_time:.3f} s'
 
     def close(self) -> None:

@@ -1,0 +1,422 @@
+# Copyright 2026 The ttb_sim Authors
+#
+# Licensed under the Apache License, Version 2.0 (the "License");
+# you may not use this file except in compliance with the License.
+# You may obtain a copy of the License at
+#
+#     http://www.apache.org/licenses/LICENSE-2.0
+#
+# Unless required by applicable law or agreed to in writing, software
+# distributed under the License is distributed on an "AS IS" BASIS,
+# WITHOUT WARRANTIES OR CONDITIONS OF ANY KIND, either express or implied.
+# See the License for the specific language governing permissions and
+# limitations under the License.
+
+"""Tests of the simulator node's ROS-free logic: parameters, passages, pacing, markers."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import pytest
+from rosbags.highlevel import AnyReader
+from ttb_sim.errors import ScenarioError
+from ttb_sim.io.bag import BagRecorder
+from ttb_sim.io.topics import topic_table
+from ttb_sim.node_logic import (ERROR, initial_values, markers, model_markers, OK,
+                                parameter_table, PassageController, SCENARIO_KEYS,
+                                train_markers, validate_changes, validate_parameter)
+from ttb_sim.scenario import key_spec, load_scenario, Scenario
+from ttb_sim.sim.frames import Frame
+
+CONTRACT_PARAMETERS = {
+    'scenario', 'train.speed_kmh', 'irregularity.spectrum', 'irregularity.seed',
+    'irregularity.file', 'irregularity.scale', 'publish_rate_hz', 'real_time_factor', 'loop',
+    'publish_clock', 'bag.enabled', 'bag.path', 'bag.storage'}
+
+
+class FakeClock:
+    """A wall clock the test moves by hand."""
+
+    def __init__(self) -> None:
+        self.now = 100.0
+
+    def __call__(self) -> float:
+        return self.now
+
+
+class ListRecorder:
+    """Collects frames like a BagRecorder."""
+
+    def __init__(self) -> None:
+        self.frames: list[Frame] = []
+        self.closed = False
+
+    def write(self, frame: Frame) -> None:
+        assert not self.closed
+        self.frames.append(frame)
+
+    def close(self) -> None:
+        self.closed = True
+
+
+@pytest.fixture(scope='module')
+def beam() -> Scenario:
+    return load_scenario('moving_force_beam')
+
+
+def controller(scenario: Scenario, recorder=None, clock=None, **values) -> PassageController:
+    table = parameter_table(scenario)
+    given = {'real_time_factor': 0.0}
+    given.update(values)
+    kwargs = {'recorder': recorder}
+    if clock is not None:
+        kwargs['clock'] = clock
+    return PassageController(scenario, initial_values(table, given), **kwargs)
+
+
+def run_until_idle(c: PassageController) -> list[Frame]:
+    published = []
+    for _ in range(1000):
+        if c.state != 'running':
+            break
+        published.extend(c.advance(budget=5.0).frames)
+    return published
+
+
+# -- parameter table ------------------------------------------------------------------------
+
+def test_parameter_names_are_the_contract(beam):
+    assert set(parameter_table(beam)) == CONTRACT_PARAMETERS
+
+
+def test_scenario_parameters_come_from_the_schema(beam):
+    table = parameter_table(beam)
+    kinds = {float: 'double', int: 'integer', str: 'string'}
+    for key in SCENARIO_KEYS:
+        typ, _, spec = key_spec(key)
+        p = table[key]
+        assert p.spec is spec
+        assert p.kind == kinds[typ]
+        assert p.scenario_key == key
+        assert p.read_only is not spec.dynamic
+        assert spec.description in p.description()
+    # defaults follow the loaded scenario, not the schema
+    assert table['train.speed_kmh'].default == 200.0
+    assert parameter_table()['train.speed_kmh'].default == key_spec('train.speed_kmh')[1]
+
+
+def test_descriptions_carry_unit_range_and_when_changes_apply(beam):
+    table = parameter_table(beam)
+    speed = table['train.speed_kmh'].description()
+    assert 'Unit: km/h' in speed and '(0, 10000] km/h' in speed and 'immediately' in speed
+    assert 'next passage' in table['irregularity.seed'].description()
+    assert 'Unit: Hz' in table['publish_rate_hz'].description()
+    assert 'Read-only' in table['bag.storage'].description()
+    assert "'mcap', 'sqlite3'" in table['bag.storage'].description()
+
+
+def test_read_only_parameters_are_structural(beam):
+    ro = {n for n, p in parameter_table(beam).items() if p.read_only}
+    assert ro == {'scenario', 'bag.enabled', 'bag.path', 'bag.storage'}
+
+
+def test_spectrum_choices_are_read_from_the_schema(beam):
+    p = parameter_table(beam)['irregularity.spectrum']
+    assert p.spec.choices == key_spec('irregularity.spectrum')[2].choices
+    for choice in p.spec.choices:
+        assert validate_parameter(p, choice) == (True, '')
+
+
+# -- validation -----------------------------------------------------------------------------
+
+@pytest.mark.parametrize('value', [350, 350.0, 1, 10000])
+def test_integer_and_float_speed_accepted(beam, value):
+    assert validate_parameter(parameter_table(beam)['train.speed_kmh'], value) == (True, '')
+
+
+@pytest.mark.parametrize('name, value, fragments', [
+    ('train.speed_kmh', -5, ['train.speed_kmh', '-5', 'out of range', '(0, 10000] km/h']),
+    ('train.speed_kmh', 0.0, ['train.speed_kmh', '0.0', '(0, 10000] km/h']),
+    ('train.speed_kmh', 10000.5, ['train.speed_kmh', '10000.5', '(0, 10000] km/h']),
+    ('train.speed_kmh', 'fast', ['train.speed_kmh', "'fast'", 'a number', '(0, 10000]']),
+    ('train.speed_kmh', True, ['train.speed_kmh', 'True', 'a number']),
+    ('train.speed_kmh', None, ['train.speed_kmh', 'None', 'a number']),
+    ('train.speed_kmh', math.nan, ['train.speed_kmh', 'nan', 'finite']),
+    ('irregularity.seed', -1, ['irregularity.seed', '-1', '[0, 2147483647]']),
+    ('irregularity.seed', 1.5, ['irregularity.seed', '1.5', 'an integer']),
+    ('irregularity.scale', 101, ['irregularity.scale', '101', '[0, 100]']),
+    ('irregularity.spectrum', 'no_such', ['irregularity.spectrum', "'no_such'", "one of 'none'"]),
+    ('irregularity.file', '/no/such/profile.csv', ['irregularity.file', 'no such file']),
+    ('publish_rate_hz', -1.0, ['publish_rate_hz', '-1.0', '[0, 10000] Hz']),
+    ('real_time_factor', -0.5, ['real_time_factor', '-0.5', '[0, 1000]']),
+    ('loop', 'yes', ['loop', "'yes'", 'true or false']),
+    ('publish_clock', 1, ['publish_clock', 'a bool']),
+    ('scenario', 'sprung_mass_beam', ['scenario', 'read-only']),
+    ('bag.enabled', True, ['bag.enabled', 'read-only']),
+    ('bag.storage', 'sqlite3', ['bag.storage', 'read-only', "'mcap', 'sqlite3'"]),
+])
+def test_refusals_name_parameter_value_and_range(beam, name, value, fragments):
+    ok, reason = validate_parameter(parameter_table(beam)[name], value)
+    assert not ok
+    for fragment in fragments:
+        assert fragment in reason, reason
+
+
+def test_changes_are_checked_all_or_nothing(beam):
+    table = parameter_table(beam)
+    ok, reason = validate_changes(table, {'train.speed_kmh': 350, 'irregularity.scale': -1})
+    assert not ok and 'irregularity.scale' in reason
+    ok, reason = validate_changes(table, {'no.such': 1})
+    assert not ok and "unknown parameter 'no.such'" in reason
+    assert validate_changes(table, {'train.speed_kmh': 350, 'loop': True}) == (True, '')
+
+
+def test_start_up_values_validated_and_normalised(beam):
+    table = parameter_table(beam)
+    values = initial_values(table, {'train.speed_kmh': 350, 'bag.enabled': True})
+    assert values['train.speed_kmh'] == 350.0 and isinstance(values['train.speed_kmh'], float)
+    assert values['bag.enabled'] is True  # read-only values may be set at start-up
+    assert values['publish_rate_hz'] == 50.0
+    with pytest.raises(ScenarioError, match=r'train\.speed_kmh = -5 .*\(0, 10000\] km/h'):
+        initial_values(table, {'train.speed_kmh': -5})
+    with pytest.raises(ScenarioError, match=r"bag\.storage = 'zip'.*'mcap', 'sqlite3'"):
+        initial_values(table, {'bag.storage': 'zip'})
+
+
+# -- passage controller ---------------------------------------------------------------------
+
+def test_speed_change_applies_at_the_next_frame(beam):
+    c = controller(beam, publish_rate_hz=0.0)
+    frames = c.advance(budget=5.0, max_frames=10).frames
+    assert frames[-1].speed == pytest.approx(200 / 3.6)
+    c.apply('train.speed_kmh', 350)   # an integer, as `ros2 param set` sends it
+    head = frames[-1].head_position
+    nxt = c.advance(budget=5.0, max_frames=1).frames[0]
+    assert nxt.speed == pytest.approx(97.2, abs=0.05)
+    assert nxt.speed == pytest.approx(350 / 3.6)
+    assert nxt.head_position - head == pytest.approx(350 / 3.6 * c.frame_period)
+    assert c.values['train.speed_kmh'] == 350.0
+    # the next passage is built at the new speed too
+    assert c.passage_scenario().train.speed_kmh == 350.0
+
+
+def test_reset_restarts_the_passage_with_continuous_time(beam):
+    c = controller(beam)
+    c.advance(budget=5.0, max_frames=200)
+    before = c.last_frame
+    message = c.reset()
+    assert 'passage 2' in message
+    first = c.advance(budget=5.0, max_frames=1).frames[0]
+    assert first.head_position == pytest.approx(beam.train.start_position)
+    assert first.time == pytest.approx(before.time + c.frame_period)
+    assert first.step == 0
+
+
+def test_pause_stops_stepping_and_resume_continues(beam):
+    c = controller(beam)
+    c.advance(budget=5.0, max_frames=5)
+    t = c.last_frame.time
+    assert 'paused' in c.set_paused(True)
+    tick = c.advance(budget=5.0)
+    assert tick.stepped == 0 and c.last_frame.time == t and c.state == 'paused'
+    c.set_paused(False)
+    assert c.advance(budget=5.0, max_frames=3).stepped == 3
+    assert c.last_frame.time == pytest.approx(t + 3 * c.frame_period)
+
+
+def test_without_loop_the_node_idles_after_the_passage(beam):
+    c = controller(beam, loop=False)
+    run_until_idle(c)
+    assert c.state == 'idle' and c.passage == 1
+    assert c.last_frame.head_position >= c.sim.exit_position
+    assert c.advance().stepped == 0
+    assert 'nothing to pause' in c.set_paused(True)
+    c.apply('loop', True)   # switching loop on wakes an idle node
+    assert c.state == 'running' and c.passage == 2
+
+
+def test_with_loop_passages_repeat(beam):
+    c = controller(beam, loop=True)
+    events, times = [], []
+    for _ in range(200):
+        tick = c.advance(budget=5.0, max_frames=500)
+        events += tick.events
+        times += [f.time for f in tick.frames]
+        if c.passage >= 3:
+            break
+    assert c.passage >= 3 and c.state == 'running'
+    assert events.count('restarted') >= 2 and 'idle' not in events
+    assert all(b > a for a, b in zip(times, times[1:]))   # /clock never goes back
+
+
+def test_speed_up_ends_the_passage_early(beam):
+    slow = controller(beam)
+    run_until_idle(slow)
+    fast = controller(beam)
+    fast.apply('train.speed_kmh', 400)
+    run_until_idle(fast)
+    assert fast.state == 'idle'
+    assert fast.last_frame.time < slow.last_frame.time
+
+
+def test_every_frame_recorded_publishing_decimated(beam):
+    rec = ListRecorder()
+    c = controller(beam, recorder=rec, publish_rate_hz=50.0)
+    published = run_until_idle(c)
+    n_frames = c.sim.n_frames
+    assert len(rec.frames) == n_frames
+    assert c.recorded == n_frames
+    times = [f.time for f in published]
+    assert times[0] == 0.0
+    assert len(published) == pytest.approx(c.last_frame.time * 50 + 1, abs=1)
+    gaps = [b - a for a, b in zip(times, times[1:])]
+    assert min(gaps) == pytest.approx(0.02, abs=1e-9)
+    assert max(gaps) == pytest.approx(0.02, abs=1e-9)
+
+
+def test_publish_rate_zero_publishes_every_frame(beam):
+    c = controller(beam, publish_rate_hz=0.0)
+    assert len(run_until_idle(c)) == c.sim.n_frames
+
+
+def test_recorded_bag_has_the_topic_table_and_every_frame(beam, tmp_path: Path):
+    c = controller(beam)
+    topics = topic_table(c.layout)
+    bag = BagRecorder(tmp_path / 'bag', topics).__enter__()
+    c.recorder = bag
+    run_until_idle(c)
+    c.close()
+    with AnyReader([tmp_path / 'bag']) as reader:
+        names = {x.topic: x.msgtype for x in reader.connections}
+        counts = {x.topic: x.msgcount for x in reader.connections}
+    assert names == {t.full_name(): t.msgtype for t in topics}
+    assert set(counts.values()) == {c.sim.n_frames}
+
+
+def test_irregularity_changes_apply_from_the_next_passage(beam):
+    c = controller(beam)
+    c.advance(budget=5.0, max_frames=3)
+    c.apply('irregularity.seed', 7)
+    c.apply('irregularity.scale', 0)
+    assert c.sim.scenario.irregularity.seed == 1   # current passage unchanged
+    assert c.passage_scenario().irregularity.seed == 7
+    c.reset()
+    assert c.sim.scenario.irregularity.seed == 7
+    assert c.sim.scenario.irregularity.scale == 0.0
+    diag = c.diagnostics().as_dict()
+    assert 'seed=7' in diag['irregularity (from next passage)']
+
+
+def test_divergence_stops_stepping_closes_the_bag_and_reports(tmp_path: Path):
+    scenario = load_scenario('moving_force_beam', ['solver.divergence_limit=1e-9'])
+    rec = ListRecorder()
+    c = controller(scenario, recorder=rec, loop=True)
+    tick = c.advance(budget=5.0)
+    assert 'diverged' in tick.events
+    assert c.state == 'diverged' and rec.closed and c.recorder is None
+    assert len(rec.frames) >= 1   # frames before the failure were recorded
+    assert c.advance().stepped == 0
+    report = c.diagnostics()
+    assert report.level == ERROR
+    assert 'diverged' in report.message and 'divergence_limit' in report.message
+    assert report.as_dict()['state'] == 'diverged'
+    assert 'nothing to pause' in c.set_paused(True)
+    # a reset restarts stepping (unrecorded: the bag stays closed)
+    c.values['bag.enabled'] = True
+    assert 'not recorded' in c.reset()
+    assert c.state == 'running'
+
+
+def test_close_is_idempotent_and_stops_stepping(beam):
+    rec = ListRecorder()
+    c = controller(beam, recorder=rec)
+    c.advance(budget=5.0, max_frames=3)
+    c.close()
+    c.close()
+    assert rec.closed and c.state == 'stopped'
+    assert c.advance().stepped == 0
+
+
+# -- pacing and diagnostics -----------------------------------------------------------------
+
+def test_real_time_factor_paces_simulation_time(beam):
+    clock = FakeClock()
+    c = controller(beam, clock=clock, real_time_factor=1.0, publish_rate_hz=0.0)
+    assert c.advance(budget=5.0).stepped == 1                        # the t = 0 frame only
+    clock.now += 0.1
+    c.advance(budget=5.0)
+    assert c.last_frame.time == pytest.approx(0.1, abs=c.frame_period)
+    tick = c.advance(budget=5.0)                                     # nothing due yet
+    assert tick.stepped == 0 and 0 < tick.sleep <= c.frame_period + 1e-9
+    c.apply('real_time_factor', 2)                         # re-anchors at the current time
+    clock.now += 0.1
+    c.advance(budget=5.0)
+    assert c.last_frame.time == pytest.approx(0.3, abs=c.frame_period)
+
+
+def test_diagnostics_report_rate_step_time_and_frame_values(beam):
+    clock = FakeClock()
+    c = controller(beam, clock=clock, real_time_factor=0.5)
+    c.diagnostics()   # open a window
+    c.advance(budget=5.0)
+    for _ in range(10):
+        clock.now += 0.1
+        c.advance(budget=5.0)
+    clock.now += 0.0001
+    report = c.diagnostics()
+    d = report.as_dict()
+    assert report.level == OK
+    assert float(d['real-time factor']) == pytest.approx(0.5, rel=0.05)
+    assert float(d['step time (ms)']) > 0
+    assert d['contact iterations'] == '0'
+    assert d['divergence'] == 'none'
+    assert d['state'] == 'running'
+    assert float(d['speed (km/h)']) == pytest.approx(200.0)
+    assert 'span01 midspan z (m)' in d
+    assert float(d['solver dt (s)']) == pytest.approx(c.sim.dt)
+
+
+def test_diagnostics_warn_when_slower_than_requested(beam):
+    clock = FakeClock()
+    c = controller(beam, clock=clock, real_time_factor=1.0)
+    c.diagnostics()
+    c.advance()
+    clock.now += 0.2
+    c.advance(max_frames=2)     # a slow machine: far fewer frames than due
+    clock.now += 0.8
+    report = c.diagnostics()
+    assert report.level == 1 and 'slower than requested' in report.message
+
+
+# -- markers --------------------------------------------------------------------------------
+
+def test_markers_describe_girders_supports_and_train():
+    scenario = load_scenario('moving_force_beam', ['bridge.n_spans=3', 'train.axle_offsets=[]',
+                                                   'train.n_cars=2'])
+    boxes = model_markers(scenario)
+    ns = [b.ns for b in boxes]
+    assert ns.count('girders') == 3 and ns.count('piers') == 2 and ns.count('abutments') == 2
+    girder = next(b for b in boxes if b.ns == 'girders' and b.marker_id == 1)
+    assert girder.position[0] == pytest.approx(1.5 * 32.0)
+    train = train_markers(scenario, 100.0)
+    cars = [b for b in train if b.ns == 'train']
+    axles = [b for b in train if b.ns == 'axles']
+    assert len(cars) == 2 and len(axles) == 8
+    assert cars[0].position[0] == pytest.approx(100.0 - 12.5)
+    assert all(0 <= v <= 1 for b in boxes + train for v in b.color)
+    full = markers(scenario, 100.0)
+    assert full.frame_id == 'track' and len(full.boxes) == len(boxes) + len(train)
+    ids = [(b.ns, b.marker_id) for b in full.boxes]
+    assert len(ids) == len(set(ids))
+
+
+def test_markers_refresh_is_throttled(beam):
+    clock = FakeClock()
+    c = controller(beam, clock=clock, real_time_factor=1.0, publish_rate_hz=0.0)
+    assert c.advance().markers
+    clock.now += 0.05
+    assert not c.advance().markers
+    clock.now += 0.06
+    assert c.advance().markers
