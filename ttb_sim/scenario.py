@@ -259,16 +259,22 @@ class FoundationConfig:
 
 @dataclass(frozen=True)
 class IrregularityConfig:
-    """Track irregularity (not yet applied by the vehicle models of this release)."""
+    """Track irregularity (applied under quarter cars; moving forces ignore it)."""
 
-    spectrum: str = param('none', '-', "Irregularity spectrum; 'none' is a smooth track.",
-                          choices=('none',), dynamic=True)
+    spectrum: str = param('none', '-', "Irregularity spectrum ('paper' = Chinese HSR 1-50 m "
+                          "plus Sato 0.05-1 m); 'none' is a smooth track.",
+                          choices=('none', 'paper', 'chinese_hsr', 'sato', 'german_low',
+                                   'german_high', 'fra1', 'fra2', 'fra3', 'fra4', 'fra5',
+                                   'fra6'), dynamic=True)
     seed: int = param(1, '-', 'Seed of the random phases (same seed, same track).', low=0,
                       high=2**31 - 1, dynamic=True)
     scale: float = param(1.0, '-', 'Factor on the irregularity amplitude; 0 gives a smooth '
                          'track.', low=0.0, high=100.0, dynamic=True)
     file: str = param('', '-', 'CSV of a measured profile (x, z_left, z_right, y_left, '
-                      'y_right in metres); empty = synthesise from the spectrum.', dynamic=True)
+                      'y_right in metres; smooth outside its range); empty = synthesise '
+                      'from the spectrum.', dynamic=True)
+    grid_spacing: float = param(0.01, 'm', 'Grid spacing of the synthesised profile (must be '
+                                'under half the shortest wavelength).', low=0.001, high=1.0)
 
 
 @dataclass(frozen=True)

@@ -29,6 +29,7 @@ import numpy as np
 
 from ttb_sim.errors import DivergenceError
 from ttb_sim.model.bridge import bearing_forces, build_structure
+from ttb_sim.model.irregularity import load_csv, synthesize, TrackIrregularity
 from ttb_sim.model.vehicle import build_vehicle, MovingForces, QuarterCars
 from ttb_sim.scenario import Scenario
 from ttb_sim.sim.frames import Frame, Layout
@@ -54,20 +55,61 @@ def nice_step(dt: float) -> float:
 
 
 def auto_time_step(fundamental_frequency: float, element_length: float, speed: float,
-                   vehicle_frequency: float | None = None) -> float:
+                   vehicle_frequency: float | None = None,
+                   profile_spacing: float | None = None) -> float:
     """
     Pick the default time step.
 
     The rule: the smallest of T1/200 (T1 = first vertical bending period of a
-    span), the time an axle takes to cross one tenth of a girder element, and
-    Tv/200 for a sprung vehicle (Tv = bounce period), rounded down to 1, 2 or
-    5 x 10^k s. Newmark's period error at T/200 is 0.008 %.
+    span), the time an axle takes to cross one tenth of a girder element,
+    Tv/200 for a sprung vehicle (Tv = bounce period) and, on an irregular
+    track, the time to cross one grid cell of the profile; rounded down to 1, 2
+    or 5 x 10^k s. Newmark's period error at T/200 is 0.008 %.
     """
     candidates = [1.0 / (STEPS_PER_PERIOD * fundamental_frequency),
                   element_length / (STEPS_PER_ELEMENT * speed)]
     if vehicle_frequency:
         candidates.append(1.0 / (STEPS_PER_PERIOD * vehicle_frequency))
+    if profile_spacing:
+        candidates.append(profile_spacing / speed)
     return nice_step(min(candidates))
+
+
+PROFILE_MARGIN = 50.0
+"""Track synthesised beyond the positions the train covers in a planned passage (m)."""
+
+
+def build_irregularity(scenario: Scenario, train_length: float,
+                       bridge_length: float) -> TrackIrregularity | None:
+    """
+    Realise the scenario's track irregularity once (None for a smooth track).
+
+    A synthesised profile covers the track from behind the last axle at the
+    start to the end of the bridge, with a margin; a measured CSV profile is
+    used as given. Outside the profile the track is smooth.
+
+    Raises
+    ------
+    ScenarioError
+        For an unreadable or invalid CSV file (the message names the row).
+
+    """
+    irr = scenario.irregularity
+    if irr.scale == 0.0 or (irr.spectrum == 'none' and not irr.file):
+        return None
+    if irr.file:
+        profile = load_csv(irr.file)
+        if irr.scale == 1.0:
+            return profile
+        return TrackIrregularity(x_start=profile.x_start, dx=profile.dx,
+                                 values=profile.values * irr.scale,
+                                 slopes=profile.slopes * irr.scale,
+                                 curvatures=profile.curvatures * irr.scale,
+                                 source=profile.source)
+    x0 = scenario.train.start_position - train_length - PROFILE_MARGIN
+    x1 = max(bridge_length, scenario.train.start_position) + PROFILE_MARGIN
+    return synthesize(irr.spectrum, length=x1 - x0, dx=irr.grid_spacing, seed=irr.seed,
+                      scale=irr.scale, x_start=x0)
 
 
 class Simulation:
@@ -88,10 +130,15 @@ class Simulation:
         self.speed = scenario.train.speed
         st = self.structure
         vf = None
+        self.irregularity: TrackIrregularity | None = None
         if isinstance(self.vehicle, QuarterCars):
             vf = float(self.vehicle.natural_frequency().max())
+            self.irregularity = build_irregularity(scenario, self.vehicle.axles.train_length,
+                                                   st.girder.length)
+        spacing = self.irregularity.dx if self.irregularity is not None else None
         dt = scenario.solver.dt or auto_time_step(st.fundamental_frequency,
-                                                  st.girder.element_length, self.speed, vf)
+                                                  st.girder.element_length, self.speed, vf,
+                                                  spacing)
         rate = scenario.output.rate_hz
         if rate > 0:
             period = 1.0 / rate
@@ -160,7 +207,8 @@ class Simulation:
                 load_full = self._moving_load(positions)
                 u, v, a = nm.step(u, v, a, load_full[st.free])
             else:
-                u, v, a = self.coupling.step(u, v, a, zero, positions, self.speed)
+                u, v, a = self.coupling.step(u, v, a, zero, positions, self.speed,
+                                             self._profile(positions))
             peak = float(np.max(np.abs(u))) if n_free else 0.0
             if not math.isfinite(peak) or peak > limit or (
                     self.coupling is not None and not np.all(np.isfinite(self.coupling.z))):
@@ -172,6 +220,13 @@ class Simulation:
                 if self.coupling is not None:
                     load_full = self._wheel_load(positions, self.coupling.contact)
                 yield self._frame(step, head, u, v, a, load_full)
+
+    def _profile(self, positions: np.ndarray) -> tuple[np.ndarray, ...] | None:
+        """Return the centreline vertical irregularity r, r', r'' under the wheels."""
+        if self.irregularity is None:
+            return None
+        s = self.irregularity.sample(positions, outside='zero')
+        return tuple(0.5 * (q[0] + q[1]) for q in (s.value, s.slope, s.curvature))
 
     def _moving_load(self, positions: np.ndarray) -> np.ndarray:
         if isinstance(self.vehicle, MovingForces):

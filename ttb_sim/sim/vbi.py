@@ -59,7 +59,9 @@ class QuarterCarCoupling:
         self._q = k + c * integrator.a1
 
     def step(self, u: np.ndarray, v: np.ndarray, a: np.ndarray, force: np.ndarray,
-             positions: np.ndarray, speed: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+             positions: np.ndarray, speed: float,
+             profile: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None,
+             ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """
         Advance girder and vehicles together by one step.
 
@@ -73,6 +75,8 @@ class QuarterCarCoupling:
             Axle positions along the track at t_{n+1} (m).
         speed : float
             Train speed during the step (m/s).
+        profile : (r, dr/dx, d2r/dx2), optional
+            Vertical track irregularity under each wheel at t_{n+1} (m, z up).
 
         Returns
         -------
@@ -90,20 +94,26 @@ class QuarterCarCoupling:
         hv_e = np.append(h_v, 0.0)[dofs]
         ha_e = np.append(h_a, 0.0)[dofs]
 
-        # Wheel kinematics at t_{n+1}: value = g . u_{n+1} + c (smooth track: r = 0).
+        # Wheel kinematics at t_{n+1}: value = g . u_{n+1} + c, with the irregularity r
+        # moving under the wheel: r, V r', V^2 r''.
         g_v = a1 * n0 + speed * n1
         g_a = a0 * n0 + 2.0 * speed * a1 * n1 + speed**2 * n2
+        c_z = np.zeros(n0.shape[0])
         c_v = np.einsum('ij,ij->i', n0, hv_e)
         c_a = np.einsum('ij,ij->i', n0, ha_e) + 2.0 * speed * np.einsum('ij,ij->i', n1, hv_e)
+        if profile is not None:
+            c_z = c_z + profile[0]
+            c_v = c_v + speed * profile[1]
+            c_a = c_a + speed**2 * profile[2]
 
         ms, mu, k, c = cars.sprung_mass, cars.unsprung_mass, cars.stiffness, cars.damping
         hs_v = -a1 * self.z - self.v
         hs_a = -a0 * self.z - 2.0 * a1 * self.v - self.a
         d, q = self._d, self._q
         p = c[:, None] * g_v + k[:, None] * n0
-        e = c * c_v - ms * hs_a - c * hs_v
+        e = c * c_v + k * c_z - ms * hs_a - c * hs_v
         w = mu[:, None] * g_a + (ms * a0 / d)[:, None] * p
-        b = (ms + mu) * G + mu * c_a + c * c_v - q * e / d - c * hs_v
+        b = (ms + mu) * G + mu * c_a + k * c_z + c * c_v - q * e / d - c * hs_v
 
         m = n0.shape[0]
         cols = np.repeat(np.arange(m), 4)
