@@ -88,8 +88,11 @@ suspension force plane 0.90 m, bogie frame centre of gravity at axle height
 they set the lateral-roll coupling.  By default the longitudinal suspension
 forces have no pitch moment arm (``longitudinal_pitch_coupling=False``), as
 in Zhai's model, whose pitch equations contain vertical forces only; this
-keeps the vertical in-plane modes those of PHYSICS.md 3.1.  With the physical
-arms (``True``) car-body and bogie pitch rise by about 0.8 %.
+keeps the vertical in-plane modes those of PHYSICS.md 3.1.  The price is that
+a rigid pitch of the whole car is force-free only as the vertical-plane
+rotation (z = -theta x, no x = theta z shift), the small-angle kinematics of
+Zhai's model.  With the physical arms (``True``) every rigid motion is
+force-free and car-body and bogie pitch rise by about 0.8 % and 0.7 %.
 
 Zero-stiffness modes of the free car (wheelsets not in contact): 6 rigid-body
 motions, 4 wheelset spins and 2 mechanisms in which each bogie rocks in
@@ -219,6 +222,29 @@ class CarParameters:
     damping per damper N s/m, lengths m.  Stiffness and damping values are per
     element; the element counts are fixed for springs (8 axle boxes, 4 air
     springs) and given by the ``n_*_dampers`` fields for dampers.
+
+    Attributes
+    ----------
+    n_primary_vertical_dampers, n_secondary_vertical_dampers : int
+        Dampers per car (default 8 and 4, one per spring position), smeared
+        evenly over the 8 axle boxes / 4 air springs.
+    n_secondary_lateral_dampers : int
+        Secondary lateral dampers per car (default 4).
+    bogie_semi_distance, axle_semi_distance : float
+        l_c = 7.85 m and l_t = 1.25 m.
+    wheel_radius : float
+        Nominal rolling radius r0 = 0.46 m.
+    contact_semi_distance : float
+        b = 0.7465 m, half the lateral distance between the contact points.
+    primary_semi_spacing, secondary_semi_spacing : float
+        Lateral semi-spacing of the axle-box springs and of the air springs
+        (assumed 1.0 m each).
+    car_body_cg_height, secondary_height, bogie_cg_height : float
+        Heights above the rail top (assumed 1.70, 0.90, 0.46 m).
+    longitudinal_pitch_coupling : bool
+        False (default): longitudinal suspension forces have no pitch moment
+        arm (Zhai-type model); True: they act at the physical heights.
+
     """
 
     car_body_mass: float = 48000.0

@@ -690,8 +690,13 @@ def contact_geometry_table(wheel: WheelParameters | None = None,
     contact_y = lateral[:, None] + wl_c * np.cos(phi)[:, None] - wz_c * np.sin(phi)[:, None]
     u_c = np.interp(side * contact_y, y_rail, u_rail)
     _, _, rcurv = rprof.evaluate(u_c)
-    return ContactGeometryTable(
+    table = ContactGeometryTable(
         lateral=lateral, roll=phi, rise=zc - zc[n_points // 2],
         rolling_radius=radius, contact_angle=angle, wheel_position=pos, rail_position=u_c,
         contact_y=contact_y, wheel_curvature=wcurv, rail_curvature=-rcurv,
         nominal_radius=r0, semi_distance=b)
+    # The table is cached and shared: make its arrays read-only.
+    for value in vars(table).values():
+        if isinstance(value, np.ndarray):
+            value.flags.writeable = False
+    return table
