@@ -1,0 +1,238 @@
+# Copyright 2026 The ttb_sim Authors
+#
+# Licensed under the Apache License, Version 2.0 (the "License");
+# you may not use this file except in compliance with the License.
+# You may obtain a copy of the License at
+#
+#     http://www.apache.org/licenses/LICENSE-2.0
+#
+# Unless required by applicable law or agreed to in writing, software
+# distributed under the License is distributed on an "AS IS" BASIS,
+# WITHOUT WARRANTIES OR CONDITIONS OF ANY KIND, either express or implied.
+# See the License for the specific language governing permissions and
+# limitations under the License.
+
+"""
+In-process tests of the rclpy node (skipped where rclpy is not importable).
+
+The node runs in its own rclpy context under a MultiThreadedExecutor spun in a
+background thread; a probe node in the same executor calls its services and
+subscribes to its topics, as ``ros2 param set`` / ``ros2 service call`` would.
+"""
+
+from __future__ import annotations
+
+import threading
+import time
+from typing import Any, Callable
+
+import pytest
+
+rclpy = pytest.importorskip(
+    'rclpy', reason='rclpy is not importable: source a ROS 2 Jazzy installation to run the '
+    'node tests (the ROS-free node logic is tested in test_node_logic.py)')
+
+from nav_msgs.msg import Odometry  # noqa: E402, I100
+from rcl_interfaces.msg import Parameter as ParameterMsg  # noqa: E402
+from rcl_interfaces.msg import ParameterType, ParameterValue  # noqa: E402
+from rcl_interfaces.srv import DescribeParameters, SetParameters  # noqa: E402
+from rclpy.context import Context  # noqa: E402
+from rclpy.executors import MultiThreadedExecutor  # noqa: E402
+from rclpy.parameter import Parameter  # noqa: E402
+from rclpy.qos import QoSProfile  # noqa: E402
+from rosbags.highlevel import AnyReader  # noqa: E402
+from std_srvs.srv import SetBool, Trigger  # noqa: E402
+from ttb_sim.errors import ScenarioError  # noqa: E402
+from ttb_sim.io.topics import topic_table  # noqa: E402
+from ttb_sim.simulator_node import SimulatorNode  # noqa: E402
+
+TIMEOUT = 10.0
+
+
+def wait_for(condition: Callable[[], Any], timeout: float = TIMEOUT) -> Any:
+    """Poll a condition until it is truthy; return its value or fail."""
+    end = time.monotonic() + timeout
+    while time.monotonic() < end:
+        value = condition()
+        if value:
+            return value
+        time.sleep(0.01)
+    pytest.fail(f'condition not met within {timeout} s')
+
+
+class Harness:
+    """A node under test, a probe node and an executor thread in a private context."""
+
+    def __init__(self, **params: Any) -> None:
+        self.context = Context()
+        rclpy.init(context=self.context)
+        overrides = [Parameter(k, value=v) for k, v in params.items()]
+        self.node = SimulatorNode(context=self.context, parameter_overrides=overrides)
+        self.probe = rclpy.create_node('ttb_sim_test_probe', context=self.context)
+        self.executor = MultiThreadedExecutor(num_threads=4, context=self.context)
+        self.executor.add_node(self.node)
+        self.executor.add_node(self.probe)
+        self.thread = threading.Thread(target=self.executor.spin, daemon=True)
+        self.thread.start()
+
+    def call(self, srv_type: Any, name: str, request: Any) -> tuple[Any, float]:
+        """Call a service; return (response, seconds from call to answer)."""
+        client = self.probe.create_client(srv_type, name)
+        assert client.wait_for_service(timeout_sec=TIMEOUT), name
+        start = time.monotonic()
+        future = client.call_async(request)
+        wait_for(future.done)
+        elapsed = time.monotonic() - start
+        self.probe.destroy_client(client)
+        return future.result(), elapsed
+
+    def set_parameter(self, name: str, value: ParameterValue) -> tuple[Any, float]:
+        """Call /ttb_sim/set_parameters with one value, as ``ros2 param set`` does."""
+        request = SetParameters.Request(parameters=[ParameterMsg(name=name, value=value)])
+        response, elapsed = self.call(SetParameters, '/ttb_sim/set_parameters', request)
+        return response.results[0], elapsed
+
+    def close(self) -> None:
+        """Close the bag, destroy the nodes and shut the context down."""
+        self.node.close()
+        self.executor.shutdown()
+        self.node.destroy_node()
+        self.probe.destroy_node()
+        rclpy.try_shutdown(context=self.context)
+        self.thread.join(timeout=TIMEOUT)
+
+
+@pytest.fixture
+def looping():
+    h = Harness(scenario='moving_force_beam', loop=True, real_time_factor=1.0,
+                publish_rate_hz=50.0)
+    yield h
+    h.close()
+
+
+def integer(value: int) -> ParameterValue:
+    return ParameterValue(type=ParameterType.PARAMETER_INTEGER, integer_value=value)
+
+
+def double(value: float) -> ParameterValue:
+    return ParameterValue(type=ParameterType.PARAMETER_DOUBLE, double_value=value)
+
+
+def test_contract_topics_services_and_types(looping):
+    expected = {
+        '/clock': 'rosgraph_msgs/msg/Clock',
+        '/diagnostics': 'diagnostic_msgs/msg/DiagnosticArray',
+        '/ttb_sim/model/markers': 'visualization_msgs/msg/MarkerArray',
+        '/ttb_sim/train/odometry': 'nav_msgs/msg/Odometry',
+        '/ttb_sim/bridge/span01/midspan': 'geometry_msgs/msg/Vector3Stamped',
+        '/ttb_sim/bearings/pier01/left': 'geometry_msgs/msg/WrenchStamped',
+    }
+
+    def topics():
+        found = dict(looping.probe.get_topic_names_and_types())
+        return found if all(name in found for name in expected) else None
+
+    found = wait_for(topics)
+    for name, msgtype in expected.items():
+        assert found[name] == [msgtype]
+    services = dict(looping.probe.get_service_names_and_types())
+    assert services['/ttb_sim/reset'] == ['std_srvs/srv/Trigger']
+    assert services['/ttb_sim/pause'] == ['std_srvs/srv/SetBool']
+    assert services['/ttb_sim/set_parameters'] == ['rcl_interfaces/srv/SetParameters']
+
+
+def test_integer_speed_accepted_and_odometry_follows(looping):
+    speeds: list[float] = []
+    looping.probe.create_subscription(
+        Odometry, '/ttb_sim/train/odometry',
+        lambda msg: speeds.append(msg.twist.twist.linear.x), QoSProfile(depth=10))
+    wait_for(lambda: speeds)
+    result, elapsed = looping.set_parameter('train.speed_kmh', integer(350))
+    assert result.successful, result.reason
+    assert elapsed < 1.0   # answered while stepping (the contract asks for 100 ms)
+    assert looping.node.get_parameter('train.speed_kmh').value == 350.0
+    n = len(speeds)
+    wait_for(lambda: len(speeds) > n + 2)
+    assert speeds[-1] == pytest.approx(97.2, abs=0.05)
+
+
+@pytest.mark.parametrize('value', [integer(-5), double(-5.0), double(0.0)])
+def test_invalid_speed_refused_with_reason(looping, value):
+    result, _ = looping.set_parameter('train.speed_kmh', value)
+    assert not result.successful
+    assert 'train.speed_kmh' in result.reason
+    assert looping.node.get_parameter('train.speed_kmh').value == 200.0
+
+
+def test_read_only_parameter_refused(looping):
+    value = ParameterValue(type=ParameterType.PARAMETER_BOOL, bool_value=True)
+    result, _ = looping.set_parameter('bag.enabled', value)
+    assert not result.successful
+
+
+def test_describe_shows_unit_and_range(looping):
+    request = DescribeParameters.Request(names=['train.speed_kmh'])
+    response, _ = looping.call(DescribeParameters, '/ttb_sim/describe_parameters', request)
+    d = response.descriptors[0]
+    assert 'km/h' in d.description and '(0, 10000]' in d.description
+    assert d.floating_point_range[0].from_value == 0.0
+    assert d.floating_point_range[0].to_value == 10000.0
+
+
+def test_pause_and_reset_services(looping):
+    times: list[float] = []
+    looping.probe.create_subscription(
+        Odometry, '/ttb_sim/train/odometry',
+        lambda msg: times.append(msg.header.stamp.sec + 1e-9 * msg.header.stamp.nanosec),
+        QoSProfile(depth=10))
+    wait_for(lambda: times)
+    response, elapsed = looping.call(SetBool, '/ttb_sim/pause', SetBool.Request(data=True))
+    assert response.success and 'paused' in response.message
+    assert elapsed < 1.0
+    time.sleep(0.2)
+    n = len(times)
+    time.sleep(0.3)
+    assert len(times) == n
+    response, _ = looping.call(SetBool, '/ttb_sim/pause', SetBool.Request(data=False))
+    assert response.success
+    wait_for(lambda: len(times) > n)
+    response, _ = looping.call(Trigger, '/ttb_sim/reset', Trigger.Request())
+    assert response.success and 'passage' in response.message
+
+
+def test_integer_start_up_speed_stored_as_double():
+    h = Harness(scenario='moving_force_beam', **{'train.speed_kmh': 350})
+    try:
+        p = h.node.get_parameter('train.speed_kmh')
+        assert p.type_ == Parameter.Type.DOUBLE and p.value == 350.0
+        assert h.node.controller.sim.speed == pytest.approx(350 / 3.6)
+    finally:
+        h.close()
+
+
+def test_invalid_start_up_value_raises():
+    context = Context()
+    rclpy.init(context=context)
+    try:
+        with pytest.raises(ScenarioError, match=r'train\.speed_kmh = -5'):
+            SimulatorNode(context=context, parameter_overrides=[
+                Parameter('train.speed_kmh', value=-5)])
+    finally:
+        rclpy.try_shutdown(context=context)
+
+
+def test_bag_holds_every_frame(tmp_path):
+    path = tmp_path / 'bag'
+    h = Harness(scenario='moving_force_beam', real_time_factor=0.0, loop=False,
+                **{'bag.enabled': True, 'bag.path': str(path)})
+    try:
+        wait_for(lambda: h.node.controller.state == 'idle')
+        frames = h.node.controller.recorded
+        layout = h.node.controller.layout
+    finally:
+        h.close()
+    with AnyReader([path]) as reader:
+        found = {c.topic: c.msgtype for c in reader.connections}
+        counts = {c.topic: c.msgcount for c in reader.connections}
+    assert found == {t.full_name(): t.msgtype for t in topic_table(layout)}
+    assert set(counts.values()) == {frames}
