@@ -167,6 +167,20 @@ def test_creep_coefficients_order_of_physics_values():
     assert f11 == pytest.approx(shear * e.a * e.b * c11, rel=1e-12)
 
 
+def test_creep_coefficients_scale_with_load():
+    """Scaling from P0 to other loads equals a direct Hertz + Kalker evaluation (1e-9)."""
+    e0 = contact.hertz_ellipse(P0, 0.46, 0.30)
+    ref = contact.creep_coefficients(e0.a, e0.b)
+    loads = np.array([2e4, 1.2e5])
+    scaled = contact.scale_creep_coefficients(ref, P0, loads)
+    e1 = contact.hertz_ellipse(loads, 0.46, 0.30)
+    direct = contact.creep_coefficients(e1.a, e1.b)
+    for s, d in zip(scaled, direct):
+        assert s == pytest.approx(d, rel=1e-9)
+    zero = contact.scale_creep_coefficients(ref, P0, -5.0)
+    assert all(float(z) == 0.0 for z in zero)
+
+
 def test_she_saturation_properties():
     """
     Shen-Hedrick-Elkins: monotonic, never above mu N, linear for small creep, cubic for beta <= 3.

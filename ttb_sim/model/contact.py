@@ -23,7 +23,7 @@ Contents (PHYSICS.md section 2):
 * Hertz elliptic contact (semi-axes, peak pressure, approach) from the
   principal curvatures, with complete elliptic integrals from scipy.
 * Kalker's linear creep coefficients f11, f22, f23, f33 from the ellipse and
-  Kalker's tabulated C_ij(a/b, nu).
+  Kalker's tabulated C_ij(a/b, nu), and their exact Hertz scaling with load.
 * Creepages from the simplified (equivalent-cone) contact geometry of
   PHYSICS.md section 2.3, or from profile rolling radii and contact angles.
 * Shen-Hedrick-Elkins saturation of the linear creep forces.
@@ -459,6 +459,38 @@ def creep_coefficients(a: ArrayLike, b: ArrayLike, *, young_modulus: float = YOU
     shear = young_modulus / (2.0 * (1.0 + poisson_ratio))
     ab = a * b
     return shear * ab * c11, shear * ab * c22, shear * ab ** 1.5 * c23, shear * ab ** 2 * c33
+
+
+def scale_creep_coefficients(coefficients: tuple[ArrayLike, ArrayLike, ArrayLike, ArrayLike],
+                             reference_load: float, load: ArrayLike) -> tuple[
+                                 np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """
+    Scale creep coefficients computed at one normal load to other loads.
+
+    For fixed curvatures the Hertz semi-axes grow as P^(1/3) and a/b does not
+    change, so f11, f22 scale as (P/P0)^(2/3), f23 as P/P0 and f33 as
+    (P/P0)^(4/3) exactly.  Loads <= 0 (no contact) give zero coefficients.
+
+    Parameters
+    ----------
+    coefficients : tuple
+        (f11, f22, f23, f33) at ``reference_load``.
+    reference_load : float
+        Load P0 (N) of ``coefficients``, > 0.
+    load : array_like
+        Normal loads P (N).
+
+    Returns
+    -------
+    tuple of numpy.ndarray
+        (f11, f22, f23, f33) at ``load``.
+
+    """
+    _check_positive('reference load', reference_load)
+    ratio = np.maximum(np.asarray(load, dtype=float), 0.0) / reference_load
+    f11, f22, f23, f33 = (np.asarray(c, dtype=float) for c in coefficients)
+    s23 = ratio ** (2.0 / 3.0)
+    return f11 * s23, f22 * s23, f23 * ratio, f33 * ratio ** (4.0 / 3.0)
 
 
 @dataclass(frozen=True)
