@@ -263,6 +263,12 @@ class SimulatorNode(Node):
 
     def _on_step(self) -> None:
         tick = self.controller.advance(budget=STEP_BUDGET)
+        if 'diverged' in tick.events:
+            self.get_logger().error(f'{self.controller.divergence}; stepping stopped, bag '
+                                    'closed; call ~/reset to restart')
+        if 'idle' in tick.events:
+            self.get_logger().info('the train has left: idle (set loop:=true or call '
+                                   '~/reset for another passage)')
         if not tick.frames or not self.context.ok():
             return
         clock = self.controller.values['publish_clock']
@@ -315,9 +321,9 @@ def marker_array(marker_set: MarkerSet) -> MarkerArray:
     header = Header(stamp=Time(sec=0, nanosec=0), frame_id=marker_set.frame_id or FRAME_ID)
     out = []
     for box in marker_set.boxes:
-        x, y, z = box.position
-        sx, sy, sz = box.size
-        r, g, b, a = box.color
+        x, y, z = (float(v) for v in box.position)
+        sx, sy, sz = (float(v) for v in box.size)
+        r, g, b, a = (float(v) for v in box.color)
         out.append(Marker(header=header, ns=box.ns, id=box.marker_id, type=Marker.CUBE,
                           action=Marker.ADD,
                           pose=Pose(position=Point(x=x, y=y, z=z),
