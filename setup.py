@@ -48,6 +48,7 @@ setup(
     entry_points={
         'console_scripts': [
             'ttb-sim = ttb_sim.cli:main',
+            'simulator = ttb_sim.simulator_node:main',
         ],
     },
 )
