@@ -329,6 +329,20 @@ def test_divergence_stops_stepping_closes_the_bag_and_reports(tmp_path: Path):
     assert c.state == 'running'
 
 
+def test_a_passage_that_cannot_start_is_reported(beam, tmp_path: Path):
+    c = controller(beam)
+    c.advance(budget=5.0, max_frames=3)
+    bad = tmp_path / 'profile.csv'
+    bad.write_text('not, a, profile\n')
+    c.apply('irregularity.file', str(bad))
+    c.apply('irregularity.spectrum', 'no_such')   # bypassing validation on purpose
+    c.reset()   # must not raise inside a service callback
+    assert c.state == 'failed'
+    report = c.diagnostics()
+    assert report.level == ERROR and 'cannot start passage 2' in report.message
+    assert c.advance().stepped == 0
+
+
 def test_close_is_idempotent_and_stops_stepping(beam):
     rec = ListRecorder()
     c = controller(beam, recorder=rec)

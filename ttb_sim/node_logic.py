@@ -45,7 +45,7 @@ import threading
 import time
 from typing import Any, Callable, Iterator, Mapping, Protocol
 
-from ttb_sim.errors import DivergenceError, ScenarioError
+from ttb_sim.errors import DivergenceError, ScenarioError, TtbSimError
 from ttb_sim.io.bag import STORAGES
 from ttb_sim.io.topics import FRAME_ID
 from ttb_sim.scenario import apply_overrides, from_mapping, key_spec, Scenario, Spec
@@ -503,7 +503,7 @@ class PassageController:
     def set_paused(self, paused: bool) -> str:
         """Pause or resume stepping; return a message."""
         with self._lock:
-            if self.state in ('idle', 'diverged', 'stopped'):
+            if self.state in ('idle', 'diverged', 'failed', 'stopped'):
                 return f'nothing to {"pause" if paused else "resume"}: {self.state}'
             self.state = 'paused' if paused else 'running'
             self._anchor = None if paused else (self._clock(), self._node_time)
@@ -648,7 +648,12 @@ class PassageController:
         if self.last_frame is not None:
             self.time_offset = self.last_frame.time + self.frame_period
         self.last_frame = None
-        self._start_passage()
+        try:
+            self._start_passage()
+        except TtbSimError as exc:   # e.g. an irregularity file that does not parse
+            self.state = 'failed'
+            self.divergence = f'cannot start passage {self.passage + 1}: {exc}'
+            log.error(self.divergence)
 
     def _start_passage(self) -> None:
         """Build a new simulation from the current parameters and start stepping it."""
@@ -732,6 +737,8 @@ class PassageController:
                 values.extend(frame_values(self.last_frame))
             if self.state == 'diverged':
                 level, message = ERROR, f'diverged: {self.divergence}'
+            elif self.state == 'failed':
+                level, message = ERROR, self.divergence
             elif self.bag_error:
                 level, message = ERROR, self.bag_error
             elif (self.state == 'running' and target > 0 and steps
