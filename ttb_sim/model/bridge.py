@@ -87,24 +87,27 @@ class GirderLine:
         xi = np.clip(x / h - element, 0.0, 1.0)
         return element, xi, on
 
-    def rows(self, x: np.ndarray, derivative: int = 0) -> tuple[np.ndarray, np.ndarray]:
+    def rows(self, x: np.ndarray, derivatives: tuple[int, ...] = (0,)
+             ) -> tuple[np.ndarray, tuple[np.ndarray, ...]]:
         """
         Return the rows that map element DOFs to the girder deflection w at x.
 
-        Positions off the bridge get zero rows.
+        Positions off the bridge get zero rows. The positions are located once
+        for all the requested derivatives.
 
         Returns
         -------
-        (element, values)
-            Element index (n_points,) and coefficients (n_points, 4) of w
-            (derivative 0), dw/dx (1) or d2w/dx2 (2) on the element's
+        (element, rows)
+            Element index (n_points,) and, per requested derivative (0: w,
+            1: dw/dx, 2: d2w/dx2), coefficients (n_points, 4) on the element's
             (uz1, ry1, uz2, ry2); index ``w_dofs`` or ``w_dofs_full`` with the
             element to get the DOFs.
 
         """
         element, xi, on = self.locate(x)
-        values = vertical_row(xi, self.element_length, derivative) * on[:, None]
-        return element, values
+        mask = on[:, None]
+        return element, tuple(vertical_row(xi, self.element_length, d) * mask
+                              for d in derivatives)
 
 
 @dataclass(frozen=True)

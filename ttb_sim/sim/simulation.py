@@ -238,7 +238,7 @@ class Simulation:
     def _wheel_load(self, positions: np.ndarray, forces: np.ndarray) -> np.ndarray:
         """Return the full-DOF load of downward wheel forces at the given positions."""
         girder = self.structure.girder
-        element, n0 = girder.rows(positions, 0)
+        element, (n0,) = girder.rows(positions)
         return np.bincount(girder.w_dofs_full[element].ravel(),
                            weights=(-forces[:, None] * n0).ravel(),
                            minlength=self.structure.n_full)

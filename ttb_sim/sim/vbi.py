@@ -57,6 +57,12 @@ class QuarterCarCoupling:
         ms, k, c = cars.sprung_mass, cars.stiffness, cars.damping
         self._d = ms * integrator.a0 + c * integrator.a1 + k
         self._q = k + c * integrator.a1
+        # Work arrays of the per-step solve, allocated once: right-hand sides
+        # [load | one unit wheel load per axle] and their solutions, each with the
+        # always-zero slot that stands for the constrained DOFs.
+        self._cols = np.repeat(np.arange(1, n + 1), 4)
+        self._rhs = np.zeros((n_free + 1, n + 1))
+        self._sol = np.zeros((n_free + 1, n + 1))
 
     def step(self, u: np.ndarray, v: np.ndarray, a: np.ndarray, force: np.ndarray,
              positions: np.ndarray, speed: float,
@@ -87,9 +93,7 @@ class QuarterCarCoupling:
         nm, cars, n_free = self.nm, self.cars, self.n_free
         a0, a1 = nm.a0, nm.a1
         h_v, h_a = nm.history(u, v, a)
-        element, n0 = self.girder.rows(positions, 0)
-        _, n1 = self.girder.rows(positions, 1)
-        _, n2 = self.girder.rows(positions, 2)
+        element, (n0, n1, n2) = self.girder.rows(positions, (0, 1, 2))
         dofs = self.girder.w_dofs[element]
         hv_e = np.append(h_v, 0.0)[dofs]
         ha_e = np.append(h_a, 0.0)[dofs]
@@ -116,12 +120,14 @@ class QuarterCarCoupling:
         b = (ms + mu) * G + mu * c_a + k * c_z + c * c_v - q * e / d - c * hs_v
 
         m = n0.shape[0]
-        cols = np.repeat(np.arange(m), 4)
-        rhs = np.zeros((n_free + 1, m + 1))
-        np.add.at(rhs, (dofs.ravel(), 0), -(n0 * b[:, None]).ravel())
-        np.add.at(rhs, (dofs.ravel(), cols + 1), n0.ravel())
+        rhs, sol = self._rhs, self._sol
+        rhs.fill(0.0)
+        flat = dofs.ravel()
+        rhs[:, 0] = np.bincount(flat, weights=-(n0 * b[:, None]).ravel(), minlength=n_free + 1)
+        # Each unit-load column holds one axle's four distinct DOFs; only the discarded
+        # zero slot can repeat, so plain assignment is exact.
+        rhs[flat, self._cols] = n0.ravel()
         rhs[:n_free, 0] += nm.effective_load(force, h_v, h_a)
-        sol = np.zeros((n_free + 1, m + 1))
         sol[:n_free] = nm.solve(rhs[:n_free])
         x0, z = sol[:, 0], sol[:, 1:]
         s = np.eye(m) + np.einsum('ik,ikj->ij', w, z[dofs])
