@@ -111,8 +111,6 @@ def _cmd_run(args: argparse.Namespace) -> int:
     scenario = load_scenario(args.scenario, args.overrides, values)
     simulation = Simulation(scenario)
     out = args.out if args.out is not None else default_output(scenario.name)
-    if out.exists():
-        raise ScenarioError(f'output directory {str(out)!r} exists; refusing to overwrite it')
     bar = None
     if sys.stderr.isatty():
         from tqdm import tqdm

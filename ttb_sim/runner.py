@@ -30,8 +30,8 @@ import time
 from typing import Any, Callable
 
 from ttb_sim import __version__
-from ttb_sim.errors import DivergenceError, ScenarioError
-from ttb_sim.io.bag import BagRecorder, STORAGES
+from ttb_sim.errors import DivergenceError
+from ttb_sim.io.bag import BagRecorder, check_destination
 from ttb_sim.io.topics import PeakTracker, topic_table
 from ttb_sim.scenario import Scenario
 from ttb_sim.sim.simulation import Simulation
@@ -96,12 +96,8 @@ def run_to_bag(scenario: Scenario, out: Path, storage: str = 'mcap',
         Re-raised after the bag and summary have been closed and written.
 
     """
-    if storage not in STORAGES:
-        raise ScenarioError(f'--storage {storage!r}: allowed values are '
-                            f'{", ".join(STORAGES)}')
     out = Path(out)
-    if out.exists():
-        raise ScenarioError(f'output directory {str(out)!r} exists; refusing to overwrite it')
+    check_destination(out, storage)  # before summary.json could land in someone's folder
     sim = simulation or Simulation(scenario)
     topics = topic_table(sim.layout)
     peaks = PeakTracker(topics)

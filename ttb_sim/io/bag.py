@@ -31,6 +31,23 @@ STORAGES = {'mcap': StoragePlugin.MCAP, 'sqlite3': StoragePlugin.SQLITE3}
 """Storage back-ends by their rosbag2 plugin names."""
 
 
+def check_destination(path: str | Path, storage: str) -> None:
+    """
+    Refuse an unknown storage or an existing bag directory, before anything is written.
+
+    Raises
+    ------
+    ScenarioError
+        Naming the storage and what is allowed, or the existing directory.
+
+    """
+    if storage not in STORAGES:
+        raise ScenarioError(f'storage {storage!r}: allowed values are {", ".join(STORAGES)}')
+    if Path(path).exists():
+        raise ScenarioError(f'output directory {str(path)!r} exists; refusing to overwrite it '
+                            '(choose another --out)')
+
+
 def typestore() -> Any:
     """Return the rosbags type store of ROS 2 Jazzy."""
     return get_typestore(Stores.ROS2_JAZZY)
@@ -63,13 +80,8 @@ class BagRecorder:
 
     def __init__(self, path: str | Path, topics: Sequence[Topic], storage: str = 'mcap',
                  namespace: str = NAMESPACE) -> None:
-        if storage not in STORAGES:
-            raise ScenarioError(f'storage {storage!r}: allowed values are '
-                                f'{", ".join(STORAGES)}')
+        check_destination(path, storage)
         self.path = Path(path)
-        if self.path.exists():
-            raise ScenarioError(f'output directory {str(self.path)!r} exists; refusing to '
-                                'overwrite it (choose another --out)')
         self._store = typestore()
         self._types = self._store.types.__getitem__
         self._topics = list(topics)
