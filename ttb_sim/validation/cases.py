@@ -21,9 +21,8 @@ and compares with an independent reference from :mod:`ttb_sim.validation.referen
 
 from __future__ import annotations
 
-from dataclasses import dataclass
 import math
-from typing import Callable, Sequence
+from typing import Sequence
 
 import numpy as np
 import scipy.sparse as sp
@@ -33,39 +32,9 @@ from ttb_sim.sim.newmark import Newmark
 from ttb_sim.sim.simulation import Simulation
 from ttb_sim.validation.references import (Beam, fryba_peak, QuarterCar,
                                            sprung_mass_modal)
+from ttb_sim.validation.rows import Case, relative_row, Row
 
 V1_ALPHAS = (0.1, 0.3, 0.5, 0.62, 1.0)
-
-
-@dataclass(frozen=True)
-class Row:
-    """One line of the validation table."""
-
-    case: str
-    quantity: str
-    computed: float
-    reference: float
-    error: float
-    tolerance: float
-    passed: bool
-    unit: str = ''
-    error_kind: str = 'relative'
-
-
-def relative_row(case: str, quantity: str, computed: float, reference: float,
-                 tolerance: float, unit: str = '') -> Row:
-    """Build a row judged by the relative error |computed - reference| / |reference|."""
-    error = abs(computed - reference) / abs(reference)
-    return Row(case, quantity, computed, reference, error, tolerance, error <= tolerance, unit)
-
-
-@dataclass(frozen=True)
-class Case:
-    """A validation case: an id, a title and a function producing rows."""
-
-    case_id: str
-    title: str
-    run: Callable[[], list[Row]]
 
 
 def midspan_history(scenario: Scenario) -> tuple[np.ndarray, Simulation]:
