@@ -118,9 +118,11 @@ def param(default: Any, unit: str, description: str, *, low: float | None = None
 class TrainConfig:
     """Train: vehicle model, axle layout and running speed."""
 
-    vehicle: str = param('moving_force', '-', 'Vehicle model: constant moving forces, or '
-                         'quarter cars (a sprung mass on a spring-dashpot over each axle).',
-                         choices=('moving_force', 'sprung_mass'))
+    vehicle: str = param('moving_force', '-', 'Vehicle model: constant moving forces, '
+                         'quarter cars (a sprung mass on a spring-dashpot over each axle), or '
+                         "42-DOF multibody cars ([P] Table 1, section 'car') on wheel-rail "
+                         "contact (needs track.model = 'slab').",
+                         choices=('moving_force', 'sprung_mass', 'car'))
     speed_kmh: float = param(300.0, 'km/h', 'Running speed of the train (the upper bound '
                              'is a numerical guard: validation runs use high speed '
                              'parameters).', low=0.0, high=10000.0, low_inclusive=False,
@@ -168,6 +170,67 @@ class TrainConfig:
 
 
 @dataclass(frozen=True)
+class CarConfig:
+    """
+    Multibody car ([P] Table 1) used by ``train.vehicle = car``.
+
+    Stiffness values are per spring (8 axle boxes and 4 air springs per car),
+    damping values per damper; the damper counts say how many act per car.
+    """
+
+    car_body_mass: float = param(48000.0, 'kg', 'Car body mass M_c.', low=1.0, high=1e6)
+    bogie_mass: float = param(3200.0, 'kg', 'Bogie frame mass M_t.', low=1.0, high=1e5)
+    wheelset_mass: float = param(2400.0, 'kg', 'Wheelset mass M_w.', low=1.0, high=1e5)
+    car_body_pitch_inertia: float = param(2.3e6, 'kg*m^2', 'Car body pitch inertia I_cy.',
+                                          low=1.0, high=1e9)
+    car_body_roll_inertia: float = param(1.15e5, 'kg*m^2', 'Car body roll inertia I_cx.',
+                                         low=1.0, high=1e9)
+    car_body_yaw_inertia: float = param(2.3e6, 'kg*m^2', 'Car body yaw inertia I_cz.',
+                                        low=1.0, high=1e9)
+    bogie_pitch_inertia: float = param(7200.0, 'kg*m^2', 'Bogie pitch inertia I_ty.', low=1.0,
+                                       high=1e7)
+    bogie_roll_inertia: float = param(3200.0, 'kg*m^2', 'Bogie roll inertia I_tx.', low=1.0,
+                                      high=1e7)
+    bogie_yaw_inertia: float = param(6800.0, 'kg*m^2', 'Bogie yaw inertia I_tz.', low=1.0,
+                                     high=1e7)
+    wheelset_roll_inertia: float = param(1200.0, 'kg*m^2', 'Wheelset roll inertia I_wx.',
+                                         low=1.0, high=1e6)
+    wheelset_spin_inertia: float = param(200.0, 'kg*m^2', 'Wheelset inertia about its axle '
+                                         'I_wy (spin perturbation and gyroscopic terms).',
+                                         low=1.0, high=1e6)
+    wheelset_yaw_inertia: float = param(1200.0, 'kg*m^2', 'Wheelset yaw inertia I_wz.',
+                                        low=1.0, high=1e6)
+    primary_stiffness_x: float = param(9.0e6, 'N/m', 'Primary longitudinal stiffness per '
+                                       'axle box.', low=1.0, high=1e10)
+    primary_stiffness_y: float = param(3.0e6, 'N/m', 'Primary lateral stiffness per axle box.',
+                                       low=1.0, high=1e10)
+    primary_stiffness_z: float = param(1.04e6, 'N/m', 'Primary vertical stiffness per axle '
+                                       'box.', low=1.0, high=1e10)
+    secondary_stiffness_x: float = param(0.24e6, 'N/m', 'Secondary longitudinal stiffness per '
+                                         'air spring.', low=1.0, high=1e10)
+    secondary_stiffness_y: float = param(0.24e6, 'N/m', 'Secondary lateral stiffness per air '
+                                         'spring.', low=1.0, high=1e10)
+    secondary_stiffness_z: float = param(0.4e6, 'N/m', 'Secondary vertical stiffness per air '
+                                         'spring.', low=1.0, high=1e10)
+    primary_damping_z: float = param(45.0e3, 'N*s/m', 'Primary vertical damping per damper.',
+                                     low=0.0, high=1e9)
+    secondary_damping_y: float = param(3.0e3, 'N*s/m', 'Secondary lateral damping per damper.',
+                                       low=0.0, high=1e9)
+    secondary_damping_z: float = param(98.0e3, 'N*s/m', 'Secondary vertical damping per '
+                                       'damper.', low=0.0, high=1e9)
+    primary_vertical_dampers: int = param(4, '-', 'Primary vertical dampers per car (one per '
+                                          'wheelset: Zhai-type bogies carry one damper per '
+                                          'side of each bogie; see README).', low=0, high=64)
+    secondary_vertical_dampers: int = param(2, '-', 'Secondary vertical dampers per car (one '
+                                            'per bogie).', low=0, high=64)
+    secondary_lateral_dampers: int = param(2, '-', 'Secondary lateral dampers per car (one '
+                                           'per bogie).', low=0, high=64)
+    wheel_radius: float = param(0.46, 'm', 'Nominal rolling radius r0.', low=0.1, high=2.0)
+    contact_semi_distance: float = param(0.7465, 'm', 'Half the lateral distance between '
+                                         'the contact points b.', low=0.3, high=1.5)
+
+
+@dataclass(frozen=True)
 class BridgeConfig:
     """Simply supported girders, modelled as 3-D Euler-Bernoulli beams."""
 
@@ -197,6 +260,82 @@ class BridgeConfig:
                                  high=0.5, high_inclusive=False)
     elements_per_span: int = param(16, '-', 'Beam elements per span (even, so that a node '
                                    'sits at mid-span).', low=2, high=400)
+
+
+@dataclass(frozen=True)
+class TrackConfig:
+    """
+    Track on the girders and on the approaches ([P] Tables 2 and 4).
+
+    ``slab``: two rails (3-D Euler beams) on discrete fasteners, a unit track
+    slab and base plate (3-D beams) on continuous spring-dashpot layers. The
+    dimensions of [P] Table 2 are those of CRTS III unit slabs.
+    """
+
+    model: str = param('none', '-', "'none': loads act on the girder axis; 'slab': rails on "
+                       'fasteners on unit slabs on base plates, continued onto approaches.',
+                       choices=('none', 'slab'))
+    approach_length: float = param(0.0, 'm', 'Track on rigid ground before and after the '
+                                   'bridge; 0 = train length + 20 m, so the whole train '
+                                   'starts and ends off the bridge.', low=0.0, high=5000.0)
+    rail_young_modulus: float = param(2.059e11, 'Pa', 'Rail elastic modulus ([P] Table 2).',
+                                      low=1e9, high=1e13)
+    rail_inertia_y: float = param(3.217e-5, 'm^4', 'Rail second moment about y (vertical '
+                                  'bending).', low=1e-8, high=1e-2)
+    rail_inertia_z: float = param(5.24e-6, 'm^4', 'Rail second moment about z (lateral '
+                                  'bending).', low=1e-8, high=1e-2)
+    rail_torsional_stiffness: float = param(1.958e5, 'N*m^2', 'Rail torsional stiffness GJ.',
+                                            low=1.0, high=1e9)
+    rail_polar_inertia: float = param(3.741e-5, 'm^4', 'Rail polar second moment (for the '
+                                      'rotary inertia).', low=1e-8, high=1e-2)
+    rail_mass: float = param(60.64, 'kg/m', 'Rail mass per metre.', low=1.0, high=1000.0)
+    rail_semi_spacing: float = param(0.7465, 'm', 'Lateral distance of each rail axis from the '
+                                     'track centre (at the wheel contact points).', low=0.3,
+                                     high=1.5)
+    rail_height: float = param(0.176, 'm', 'Rail height; the contact is at the top, the '
+                               'fastener at the foot, the axis at mid-height.', low=0.05,
+                               high=0.5)
+    fastener_spacing: float = param(0.63, 'm', 'Fastener spacing ([P] Table 2).', low=0.2,
+                                    high=2.0)
+    rail_elements_per_bay: int = param(2, '-', 'Rail beam elements between fasteners.',
+                                       low=1, high=16)
+    fastener_vertical_stiffness: float = param(5e7, 'N/m', 'Fastener vertical stiffness.',
+                                               low=1.0, high=1e12)
+    fastener_lateral_stiffness: float = param(3e7, 'N/m', 'Fastener lateral stiffness.',
+                                              low=1.0, high=1e12)
+    fastener_longitudinal_stiffness: float = param(2e7, 'N/m', 'Fastener longitudinal '
+                                                   'stiffness (assumed; not in [P]).', low=1.0,
+                                                   high=1e12)
+    fastener_vertical_damping: float = param(3.6e4, 'N*s/m', 'Fastener vertical damping.',
+                                             low=0.0, high=1e9)
+    fastener_lateral_damping: float = param(3e4, 'N*s/m', 'Fastener lateral (and '
+                                            'longitudinal) damping.', low=0.0, high=1e9)
+    rail_foot_width: float = param(0.15, 'm', 'Rail foot width: the pad resists rail roll '
+                                   'with k_v w^2 / 12.', low=0.01, high=0.5)
+    fasteners_per_slab: int = param(9, '-', 'Fasteners per slab unit (9 x 0.63 m = 5.67 m '
+                                    'pitch: 5.6 m slab + gap).', low=1, high=100)
+    slab_gap: float = param(0.07, 'm', 'Gap between slab units.', low=0.0, high=1.0)
+    slab_width: float = param(2.5, 'm', 'Track slab width.', low=0.5, high=10.0)
+    slab_thickness: float = param(0.21, 'm', 'Track slab thickness.', low=0.05, high=2.0)
+    slab_young_modulus: float = param(3.6e10, 'Pa', 'Slab concrete modulus (C60).', low=1e8,
+                                      high=1e12)
+    base_width: float = param(3.1, 'm', 'Base plate width.', low=0.5, high=10.0)
+    base_thickness: float = param(0.3, 'm', 'Base plate thickness.', low=0.05, high=2.0)
+    base_young_modulus: float = param(3.25e10, 'Pa', 'Base plate concrete modulus (C40).',
+                                      low=1e8, high=1e12)
+    concrete_density: float = param(2500.0, 'kg/m^3', 'Density of slab and base plate '
+                                    'concrete.', low=100.0, high=1e4)
+    filling_thickness: float = param(0.09, 'm', 'Self-compacting filling layer between slab '
+                                     'and base (its mass is shared between them).', low=0.0,
+                                     high=1.0)
+    layer_stiffness: float = param(1.5e9, 'N/m^2', 'Continuous layer stiffness per metre of '
+                                   'track, vertical and lateral ([P] Table 4); used between '
+                                   'slab and base, base and girder, base and ground.', low=1.0,
+                                   high=1e13)
+    layer_damping: float = param(8.3e4, 'N*s/m^2', 'Continuous layer damping per metre of '
+                                 'track ([P] Table 4).', low=0.0, high=1e10)
+    girder_top_height: float = param(1.1, 'm', 'Height of the girder top surface above the '
+                                     'girder axis.', low=0.0, high=10.0)
 
 
 @dataclass(frozen=True)
@@ -278,6 +417,26 @@ class IrregularityConfig:
 
 
 @dataclass(frozen=True)
+class ContactConfig:
+    """Wheel-rail contact of multibody cars (PHYSICS.md section 2)."""
+
+    tread: str = param('lm', '-', "Zhai's Hertz constant: worn 'lm' or 'conical' tread.",
+                       choices=('lm', 'conical'))
+    friction: float = param(0.3, '-', 'Friction coefficient of the Shen-Hedrick-Elkins '
+                            'saturation.', low=0.0, high=1.0, low_inclusive=False)
+    geometry: str = param('profiles', '-', "'profiles': LMA wheel on CHN60 rail contact "
+                          "table; 'conicity': equivalent cone.",
+                          choices=('profiles', 'conicity'))
+    conicity: float = param(0.05, '-', "Equivalent conicity for geometry = 'conicity'.",
+                            low=0.0, high=1.0)
+    tolerance: float = param(1e-9, 'm', 'Convergence tolerance of the contact iteration on '
+                             'the compression of every wheel.', low=1e-15, high=1e-3,
+                             low_inclusive=False)
+    max_iterations: int = param(30, '-', 'Contact iterations per step before the run stops '
+                                'as diverged.', low=1, high=1000)
+
+
+@dataclass(frozen=True)
 class SolverConfig:
     """Time integration (Newmark average acceleration)."""
 
@@ -301,6 +460,10 @@ class OutputConfig:
     rate_hz: float = param(0.0, 'Hz', 'Frame (message) rate in simulation time; 0 = every '
                            'solver step. Rounded so that frames fall on solver steps.',
                            low=0.0, high=1e6)
+    observers: tuple[str, ...] = param((), '-', 'Named displacement observers, each '
+                                       "'name=component@x' with component rail_left, "
+                                       'rail_right, slab, base or girder and x the position '
+                                       'along the track (m); published on ~/observers/name.')
 
 
 @dataclass(frozen=True)
@@ -310,6 +473,9 @@ class Scenario:
     name: str = param('custom', '-', 'Short name of the scenario.')
     description: str = param('', '-', 'One line describing the scenario.')
     train: TrainConfig = field(default_factory=TrainConfig)
+    car: CarConfig = field(default_factory=CarConfig)
+    track: TrackConfig = field(default_factory=TrackConfig)
+    contact: ContactConfig = field(default_factory=ContactConfig)
     bridge: BridgeConfig = field(default_factory=BridgeConfig)
     bearings: BearingsConfig = field(default_factory=BearingsConfig)
     piers: PiersConfig = field(default_factory=PiersConfig)
@@ -422,6 +588,10 @@ def _coerce(path: str, value: Any, typ: Any, spec: Spec) -> Any:
         items = tuple(_coerce_number(f'{path}[{i}]', v, float, spec)
                       for i, v in enumerate(value))
         return items
+    if typ in (tuple[str, ...],):
+        if not isinstance(value, (list, tuple)) or not all(isinstance(v, str) for v in value):
+            raise ScenarioError(f'{path} = {value!r}: expected a list of strings')
+        return tuple(value)
     if typ is str:
         if not isinstance(value, str):
             raise ScenarioError(f'{path} = {value!r}: expected a string, {spec.allowed()}')
@@ -460,6 +630,60 @@ def _check_consistency(s: Scenario) -> None:
     if s.foundation.model == 'springs' and s.bearings.model == 'rigid':
         raise ScenarioError("foundation.model = 'springs' needs bearings.model = 'elastic' "
                             '(rigid bearings model ideal fixed supports)')
+    if s.train.vehicle == 'car' and s.track.model != 'slab':
+        raise ScenarioError(f"train.vehicle = 'car' needs track.model = 'slab' (got "
+                            f'{s.track.model!r}): wheels run on rails')
+    if s.track.model == 'slab' and s.train.vehicle != 'car':
+        raise ScenarioError(f"track.model = 'slab' needs train.vehicle = 'car' (got "
+                            f'{s.train.vehicle!r})')
+    parse_observers(s.output.observers)
+
+
+OBSERVER_COMPONENTS = ('rail_left', 'rail_right', 'slab', 'base', 'girder')
+_OBSERVER = re.compile(r'^([A-Za-z][A-Za-z0-9_]*)=([a-z_]+)@(.+)$')
+
+
+@dataclass(frozen=True)
+class Observer:
+    """A named displacement observation point (``output.observers``)."""
+
+    name: str
+    component: str
+    x: float
+
+
+def parse_observers(entries: Sequence[str]) -> tuple[Observer, ...]:
+    """
+    Parse ``output.observers`` entries of the form ``name=component@x``.
+
+    Raises
+    ------
+    ScenarioError
+        Naming the entry and what is allowed, for a malformed entry, an unknown
+        component, a non-finite position or a repeated name.
+
+    """
+    out: list[Observer] = []
+    for i, entry in enumerate(entries):
+        path = f'output.observers[{i}] = {entry!r}'
+        match = _OBSERVER.match(entry.strip())
+        if not match:
+            raise ScenarioError(f"{path}: expected 'name=component@x' with a name of "
+                                'letters, digits and _ (starting with a letter)')
+        name, component, x_text = match.groups()
+        if component not in OBSERVER_COMPONENTS:
+            raise ScenarioError(f'{path}: component {component!r} is unknown; allowed: '
+                                f'{", ".join(OBSERVER_COMPONENTS)}')
+        try:
+            x = float(x_text)
+        except ValueError:
+            x = math.nan
+        if not math.isfinite(x):
+            raise ScenarioError(f'{path}: position {x_text!r} is not a finite number (m)')
+        if any(o.name == name for o in out):
+            raise ScenarioError(f'{path}: observer name {name!r} is used twice')
+        out.append(Observer(name, component, x))
+    return tuple(out)
 
 
 def _to_plain(value: Any) -> Any:

@@ -93,3 +93,29 @@ def link_matrices(kinematics: np.ndarray, stiffness: np.ndarray) -> np.ndarray:
 
     """
     return np.einsum('eai,ea,eaj->eij', kinematics, stiffness, kinematics)
+
+
+def assemble_links(n_dofs: int, dofs: np.ndarray, kinematics: np.ndarray,
+                   stiffness: np.ndarray) -> sp.csr_matrix:
+    """
+    Assemble spring (or dashpot) links whose DOF index -1 stands for rigid ground.
+
+    Parameters
+    ----------
+    n_dofs : int
+        Size of the global matrix.
+    dofs : array of int, shape (n, n_local)
+        Global DOFs of each link; -1 marks a grounded (fixed) DOF.
+    kinematics : array, shape (n, n_dir, n_local)
+        Rows of the link's relative motion per direction.
+    stiffness : array, shape (n, n_dir)
+        Stiffness (or damping) per direction.
+
+    Returns
+    -------
+    scipy.sparse.csr_matrix
+
+    """
+    keep = dofs >= 0
+    matrices = link_matrices(kinematics, stiffness) * keep[:, :, None] * keep[:, None, :]
+    return assemble(n_dofs, np.where(keep, dofs, 0), matrices)

@@ -207,3 +207,96 @@ def global_matrices(start: np.ndarray, end: np.ndarray,
     kg = np.einsum('eji,ejk,ekl->eil', t, k, t)
     mg = np.einsum('eji,ejk,ekl->eil', t, m, t)
     return kg, mg, rot
+
+
+def field_rows(xi: np.ndarray, length: np.ndarray, derivative: int = 0) -> np.ndarray:
+    """
+    Map the 12 DOFs of elements along global x to the six fields at points.
+
+    The fields are (u, v, w, theta_x, theta_y, theta_z) with theta_y = -w' and
+    theta_z = v' (the node rotations of the same element), or their first
+    x-derivatives.
+
+    Parameters
+    ----------
+    xi : array
+        Local coordinate in [0, 1], shape (n,).
+    length : array
+        Element length (m), broadcast with ``xi``.
+    derivative : int
+        0 or 1.
+
+    Returns
+    -------
+    numpy.ndarray
+        Shape (n, 6, 12).
+
+    """
+    if derivative not in (0, 1):
+        raise ValueError(f'derivative must be 0 or 1, got {derivative}')
+    xi = np.asarray(xi, dtype=float)
+    length = np.broadcast_to(np.asarray(length, dtype=float), xi.shape)
+    out = np.zeros(xi.shape + (6, ELEMENT_DOFS))
+    if derivative == 0:
+        lin = np.stack([1.0 - xi, xi], axis=-1)
+    else:
+        lin = np.stack([-1.0 / length, 1.0 / length], axis=-1)
+    out[..., 0, [0, 6]] = lin
+    out[..., 3, [3, 9]] = lin
+    out[..., 1, V_DOFS] = lateral_row(xi, length, derivative)
+    out[..., 2, W_DOFS] = vertical_row(xi, length, derivative)
+    out[..., 4, W_DOFS] = -vertical_row(xi, length, derivative + 1)
+    out[..., 5, V_DOFS] = lateral_row(xi, length, derivative + 1)
+    return out
+
+
+def point_rows(xi: np.ndarray, length: np.ndarray, arm: np.ndarray,
+               derivative: int = 0) -> np.ndarray:
+    """
+    Map the 12 DOFs of elements along global x to the motion of offset points.
+
+    A point at ``arm`` = (0, r_y, r_z) from the axis moves by u + theta x r.
+
+    Parameters
+    ----------
+    xi, length : array
+        Local coordinate and element length, shape (n,).
+    arm : array
+        Offset of each point from the axis, shape (n, 3) or (3,) (m).
+    derivative : int
+        0 for the displacement, 1 for its x-derivative.
+
+    Returns
+    -------
+    numpy.ndarray
+        Shape (n, 3, 12): rows of the x, y, z displacement of each point.
+
+    """
+    return offset_rows(field_rows(xi, length, derivative), arm)
+
+
+def offset_rows(fields: np.ndarray, arm: np.ndarray) -> np.ndarray:
+    """
+    Turn field rows (..., 6, n) into rows of the motion u + theta x r of offset points.
+
+    Parameters
+    ----------
+    fields : array
+        Rows of (u, v, w, theta_x, theta_y, theta_z), shape (..., 6, n).
+    arm : array
+        Offset r of the points from the axis, shape (..., 3) or (3,) (m).
+
+    Returns
+    -------
+    numpy.ndarray
+        Shape (..., 3, n).
+
+    """
+    r = np.broadcast_to(np.asarray(arm, dtype=float), fields.shape[:-2] + (3,))
+    t, q = fields[..., :3, :], fields[..., 3:, :]
+    out = t.copy()
+    # theta x r = (ty rz - tz ry, tz rx - tx rz, tx ry - ty rx)
+    out[..., 0, :] += q[..., 1, :] * r[..., 2, None] - q[..., 2, :] * r[..., 1, None]
+    out[..., 1, :] += q[..., 2, :] * r[..., 0, None] - q[..., 0, :] * r[..., 2, None]
+    out[..., 2, :] += q[..., 0, :] * r[..., 1, None] - q[..., 1, :] * r[..., 0, None]
+    return out

@@ -181,11 +181,14 @@ def topic_table(layout: Layout) -> list[Topic]:
             lambda f, i=i: np.concatenate([f.body_acceleration[i],
                                            f.body_angular_velocity[i]]),
             build_imu, unit='m/s^2, rad/s'))
-        for s, side in enumerate(('left', 'right')):
-            topics.append(Topic(
-                f'wheel_rail/car{i + 1:02d}/axle1/{side}', 'geometry_msgs/msg/WrenchStamped',
-                WRENCH, lambda f, i=i: np.concatenate([0.5 * f.contact_force[i], np.zeros(3)]),
-                build_wrench_stamped, unit='N'))
+        for k in range(layout.n_axles):
+            for s, side in enumerate(('left', 'right')):
+                topics.append(Topic(
+                    f'wheel_rail/car{i + 1:02d}/axle{k + 1}/{side}',
+                    'geometry_msgs/msg/WrenchStamped', WRENCH,
+                    lambda f, i=i, k=k, s=s: np.concatenate([f.wheel_rail[i, k, s],
+                                                             np.zeros(3)]),
+                    build_wrench_stamped, unit='N'))
     for k in range(layout.n_spans):
         topics.append(Topic(f'bridge/span{k + 1:02d}/midspan',
                             'geometry_msgs/msg/Vector3Stamped', VECTOR3,
@@ -196,6 +199,9 @@ def topic_table(layout: Layout) -> list[Topic]:
                 f'bearings/pier{s + 1:02d}/{side}', 'geometry_msgs/msg/WrenchStamped', WRENCH,
                 lambda f, s=s, j=side_index: np.concatenate([f.bearings[s, j], np.zeros(3)]),
                 build_wrench_stamped, unit='N'))
+    for j, name in enumerate(layout.observers):
+        topics.append(Topic(f'observers/{name}', 'geometry_msgs/msg/Vector3Stamped', VECTOR3,
+                            lambda f, j=j: f.observers[j], build_vector3_stamped, unit='m'))
     return topics
 
 

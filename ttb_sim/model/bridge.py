@@ -36,9 +36,18 @@ import math
 import numpy as np
 import scipy.sparse as sp
 
-from ttb_sim.fe.assembly import assemble, link_kinematics, link_matrices
-from ttb_sim.fe.beam import BeamSection, global_matrices, NODE_DOFS, vertical_row, W_DOFS
-from ttb_sim.scenario import Scenario
+from ttb_sim.fe.assembly import assemble, assemble_links, link_kinematics
+from ttb_sim.fe.beam import (BeamSection, field_rows, global_matrices, NODE_DOFS,
+                             offset_rows, vertical_row, W_DOFS)
+from ttb_sim.model.track import build_track, TrackMesh
+from ttb_sim.scenario import Scenario, TrainConfig
+
+
+def train_length(train: TrainConfig) -> float:
+    """Return the length of the train from its head to its last axle or car end (m)."""
+    if train.vehicle == 'car':
+        return train.n_cars * train.car_length
+    return max(train.axle_positions())
 
 
 @dataclass(frozen=True)
@@ -57,6 +66,8 @@ class GirderLine:
     """(n_elements, 4) extended free index of (uz1, ry1, uz2, ry2)."""
     w_dofs_full: np.ndarray
     """(n_elements, 4) full DOF index of the same."""
+    element_dofs: np.ndarray
+    """(n_elements, 12) full DOF index of all the element's DOFs."""
 
     @property
     def length(self) -> float:
@@ -173,6 +184,8 @@ class Structure:
     """First vertical bending frequency of a simply supported span (Hz)."""
     rayleigh: tuple[float, float]
     """Rayleigh coefficients (a0, a1) of C = a0 M + a1 K for the beams."""
+    track: TrackMesh | None = None
+    """The slab track (full DOF numbering), if modelled."""
 
     @property
     def n_free(self) -> int:
@@ -236,6 +249,28 @@ def build_structure(scenario: Scenario) -> Structure:
                                              pr.torsional_stiffness, pr.bending_stiffness,
                                              pr.bending_stiffness, pr.mass_per_length,
                                              pr.mass_per_length))
+    n_bridge_el = sum(c.shape[0] for c in conn)
+    girder_el = conn[0]
+    girder_el_dofs = (girder_el[:, :, None] * NODE_DOFS + np.arange(NODE_DOFS)).reshape(-1, 12)
+    track = None
+    if scenario.track.model == 'slab':
+        line = GirderLine(span_length=span, n_spans=n_spans, elements_per_span=ne,
+                          w_dofs=girder_el_dofs[:, W_DOFS], w_dofs_full=girder_el_dofs[:, W_DOFS],
+                          element_dofs=girder_el_dofs)
+
+        def girder_rows(x: np.ndarray, arm: np.ndarray
+                        ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+            element, xi, on = line.locate(x)
+            f = field_rows(xi, line.element_length)
+            rows = np.concatenate([offset_rows(f, arm), f[:, 3:4, :]], axis=1)
+            return girder_el_dofs[element], rows * on[:, None, None], on
+
+        track = build_track(scenario.track, span * n_spans, train_length(scenario.train),
+                            n_nodes, girder_rows)
+        coords.append(track.coords)
+        conn.append(track.elements)
+        sections.append(track.sections)
+        n_nodes += track.coords.shape[0]
     xyz = np.concatenate(coords)
     elements = np.concatenate(conn)
     section = BeamSection(*(np.concatenate([getattr(s, f) for s in sections])
@@ -246,10 +281,20 @@ def build_structure(scenario: Scenario) -> Structure:
     k_beam = assemble(n_full, edofs, ke)
     m_full = assemble(n_full, edofs, me)
 
+    # Rayleigh damping for the girders and piers only; the track is damped by its
+    # fasteners and layers.
     f1 = span_frequency(span, b.bending_stiffness, b.mass_per_length)
     a0, a1 = rayleigh_coefficients(b.damping_ratio, f1, 4 * f1)
-    c_full = (a0 * m_full + a1 * k_beam).tocsr()
+    nb = slice(0, n_bridge_el)
+    c_full = (a0 * assemble(n_full, edofs[nb], me[nb])
+              + a1 * assemble(n_full, edofs[nb], ke[nb])).tocsr()
     k_full = k_beam.copy()
+    if track is not None:
+        for links in track.links:
+            k_full = k_full + assemble_links(n_full, links.dofs, links.kinematics,
+                                             links.stiffness)
+            c_full = c_full + assemble_links(n_full, links.dofs, links.kinematics,
+                                             links.damping)
 
     # Supports.
     constrained = np.zeros(n_full, dtype=bool)
@@ -284,12 +329,8 @@ def build_structure(scenario: Scenario) -> Structure:
         ground = np.repeat(top < 0, NODE_DOFS).reshape(-1, NODE_DOFS)
         link_full = np.concatenate([girder_end[:, None] * NODE_DOFS + np.arange(NODE_DOFS),
                                     np.where(ground, -1, full_b)], axis=1)
-        keep = link_full >= 0
-        kl = link_matrices(kin, kdir) * keep[:, :, None] * keep[:, None, :]
-        cl = link_matrices(kin, cdir) * keep[:, :, None] * keep[:, None, :]
-        safe = np.where(keep, link_full, 0)
-        k_full = k_full + assemble(n_full, safe, kl)
-        c_full = c_full + assemble(n_full, safe, cl)
+        k_full = k_full + assemble_links(n_full, link_full, kin, kdir)
+        c_full = c_full + assemble_links(n_full, link_full, kin, cdir)
         bearing_links = (kin, link_full, kdir, cdir, support, side)
     if piers and n_spans > 1:
         base = pier_base[1:n_spans]
@@ -328,14 +369,15 @@ def build_structure(scenario: Scenario) -> Structure:
     el_nodes = conn[0]
     wfull = el_nodes[:, [0, 0, 1, 1]] * NODE_DOFS + W_DOFS % NODE_DOFS
     girder = GirderLine(span_length=span, n_spans=n_spans, elements_per_span=ne,
-                        w_dofs=full_to_free[wfull], w_dofs_full=wfull)
+                        w_dofs=full_to_free[wfull], w_dofs_full=wfull,
+                        element_dofs=girder_el_dofs)
     mid = girder_nodes[:, ne // 2]
     midspan = full_to_free[mid[:, None] * NODE_DOFS + np.arange(3)]
     return Structure(mass=reduce(m_full), damping=reduce(c_full), stiffness=reduce(k_full),
                      n_full=n_full, free=free, full_to_free=full_to_free, girder=girder,
                      midspan_dofs=midspan, bearings=bearings, rigid=rigid,
                      n_supports=n_supports, bearing_spacing=br.spacing,
-                     fundamental_frequency=f1, rayleigh=(a0, a1))
+                     fundamental_frequency=f1, rayleigh=(a0, a1), track=track)
 
 
 def _uniform_section(n: int, ea: float, gj: float, ei_y: float, ei_z: float, mass: float,

@@ -76,13 +76,37 @@ class QuarterCars:
         return np.sqrt(self.stiffness / self.sprung_mass) / (2 * np.pi)
 
 
-Vehicle = MovingForces | QuarterCars
+@dataclass(frozen=True)
+class MultibodyCars:
+    """
+    A train of 42-DOF cars (:mod:`ttb_sim.model.car`) on wheel-rail contact.
+
+    Only the axle layout lives here; the matrices and the contact state belong
+    to :class:`ttb_sim.sim.ttbi.TrainTrackCoupling`.
+    """
+
+    axles: Axles
+    n_cars: int
+    car_length: float
+
+    @property
+    def length(self) -> float:
+        """Length of the train over couplers (m)."""
+        return self.n_cars * self.car_length
+
+
+Vehicle = MovingForces | QuarterCars | MultibodyCars
 
 
 def build_vehicle(train: TrainConfig) -> Vehicle:
     """Build the vehicle model a scenario's train section describes."""
     axles = Axles(offsets=np.asarray(train.axle_positions(), dtype=float))
     n = axles.count
+    if train.vehicle == 'car':
+        from dataclasses import replace
+        layout = replace(train, axle_offsets=()).axle_positions()
+        return MultibodyCars(axles=Axles(offsets=np.asarray(layout, dtype=float)),
+                             n_cars=train.n_cars, car_length=train.car_length)
     if train.vehicle == 'moving_force':
         return MovingForces(axles=axles, loads=np.full(n, train.axle_load))
     return QuarterCars(axles=axles, sprung_mass=np.full(n, train.sprung_mass),

@@ -29,6 +29,10 @@ class Layout:
     n_supports: int
     n_bodies: int
     """Number of car bodies with an IMU (quarter cars: one per axle)."""
+    n_axles: int = 1
+    """Axles per body with wheel-rail forces (4 for multibody cars)."""
+    observers: tuple[str, ...] = ()
+    """Names of the displacement observers."""
 
 
 @dataclass(frozen=True)
@@ -46,7 +50,8 @@ class Frame:
     bearings : (n_supports, 2, 3) bearing forces on each support, left/right (N)
     body_acceleration : (n_bodies, 3) car-body acceleration, gravity excluded (m/s^2)
     body_angular_velocity : (n_bodies, 3) car-body angular velocity (rad/s)
-    contact_force : (n_bodies, 3) force of the rail on each body's wheel (N), z up
+    wheel_rail : (n_bodies, n_axles, 2, 3) force of the rail on each wheel, left/right (N)
+    observers : (n_observers, 3) displacement at each observer (m)
 
     """
 
@@ -58,7 +63,8 @@ class Frame:
     bearings: np.ndarray
     body_acceleration: np.ndarray
     body_angular_velocity: np.ndarray
-    contact_force: np.ndarray
+    wheel_rail: np.ndarray
+    observers: np.ndarray
 
     @property
     def stamp_ns(self) -> int:

@@ -27,13 +27,15 @@ from typing import Iterator
 
 import numpy as np
 
-from ttb_sim.errors import DivergenceError
-from ttb_sim.model.bridge import bearing_forces, build_structure
+from ttb_sim.errors import DivergenceError, ScenarioError
+from ttb_sim.fe.beam import point_rows
+from ttb_sim.model.bridge import bearing_forces, build_structure, Structure
 from ttb_sim.model.irregularity import load_csv, synthesize, TrackIrregularity
-from ttb_sim.model.vehicle import build_vehicle, MovingForces, QuarterCars
-from ttb_sim.scenario import Scenario
+from ttb_sim.model.vehicle import build_vehicle, MovingForces, MultibodyCars, QuarterCars
+from ttb_sim.scenario import parse_observers, Scenario
 from ttb_sim.sim.frames import Frame, Layout
 from ttb_sim.sim.newmark import Newmark
+from ttb_sim.sim.ttbi import TrainTrackCoupling
 from ttb_sim.sim.vbi import QuarterCarCoupling
 
 log = logging.getLogger(__name__)
@@ -75,18 +77,68 @@ def auto_time_step(fundamental_frequency: float, element_length: float, speed: f
     return nice_step(min(candidates))
 
 
+CONTACT_STEP = 1e-4
+"""Largest automatic time step with wheel-rail contact (s), the step of [P]."""
+
+
+def observer_rows(scenario: Scenario, structure: Structure) -> tuple[np.ndarray, np.ndarray]:
+    """
+    Return (extended free DOFs (n, 12), rows (n, 3, 12)) of the scenario's observers.
+
+    Raises
+    ------
+    ScenarioError
+        For an observer on a track component without a track, or outside the
+        component.
+
+    """
+    observers = parse_observers(scenario.output.observers)
+    dofs = np.zeros((len(observers), 12), dtype=int)
+    rows = np.zeros((len(observers), 3, 12))
+    ftf = structure.full_to_free
+    for i, obs in enumerate(observers):
+        where = f'output.observers[{i}] = {obs.name}={obs.component}@{obs.x:g}'
+        x = np.array([obs.x])
+        if obs.component == 'girder':
+            girder = structure.girder
+            element, xi, on = girder.locate(x)
+            if not on[0]:
+                raise ScenarioError(f'{where}: x is off the bridge; allowed: 0..'
+                                    f'{girder.length:g} m')
+            full = girder.element_dofs[element[0]]
+            r = point_rows(xi, girder.element_length, np.zeros(3))[0]
+        else:
+            track = structure.track
+            if track is None:
+                raise ScenarioError(f'{where}: component {obs.component!r} needs '
+                                    "track.model = 'slab'")
+            line = {'rail_left': track.rails[0], 'rail_right': track.rails[1],
+                    'slab': track.slab, 'base': track.base}[obs.component]
+            element, r3, inside = line.rows(x, np.zeros(3))
+            if not inside[0]:
+                raise ScenarioError(f'{where}: x is not on the {obs.component} (the track '
+                                    f'runs from {track.x_start:g} to {track.x_end:g} m; slab '
+                                    'and base units have gaps)')
+            full = line.dofs[element[0]]
+            r = r3[0]
+        dofs[i] = ftf[full]
+        rows[i] = r
+    return dofs, rows
+
+
 PROFILE_MARGIN = 50.0
 """Track synthesised beyond the positions the train covers in a planned passage (m)."""
 
 
-def build_irregularity(scenario: Scenario, train_length: float,
-                       bridge_length: float) -> TrackIrregularity | None:
+def build_irregularity(scenario: Scenario, train_length: float, bridge_length: float,
+                       extent: tuple[float, float] | None = None) -> TrackIrregularity | None:
     """
     Realise the scenario's track irregularity once (None for a smooth track).
 
-    A synthesised profile covers the track from behind the last axle at the
-    start to the end of the bridge, with a margin; a measured CSV profile is
-    used as given. Outside the profile the track is smooth.
+    A synthesised profile covers ``extent`` (the modelled track) or else the
+    track from behind the last axle at the start to the end of the bridge, with
+    a margin; a measured CSV profile is used as given. Outside the profile the
+    track is smooth.
 
     Raises
     ------
@@ -106,8 +158,11 @@ def build_irregularity(scenario: Scenario, train_length: float,
                                  slopes=profile.slopes * irr.scale,
                                  curvatures=profile.curvatures * irr.scale,
                                  source=profile.source)
-    x0 = scenario.train.start_position - train_length - PROFILE_MARGIN
-    x1 = max(bridge_length, scenario.train.start_position) + PROFILE_MARGIN
+    if extent is not None:
+        x0, x1 = extent
+    else:
+        x0 = scenario.train.start_position - train_length - PROFILE_MARGIN
+        x1 = max(bridge_length, scenario.train.start_position) + PROFILE_MARGIN
     return synthesize(irr.spectrum, length=x1 - x0, dx=irr.grid_spacing, seed=irr.seed,
                       scale=irr.scale, x_start=x0)
 
@@ -131,14 +186,21 @@ class Simulation:
         st = self.structure
         vf = None
         self.irregularity: TrackIrregularity | None = None
+        element = st.girder.element_length
         if isinstance(self.vehicle, QuarterCars):
             vf = float(self.vehicle.natural_frequency().max())
             self.irregularity = build_irregularity(scenario, self.vehicle.axles.train_length,
                                                    st.girder.length)
+        elif isinstance(self.vehicle, MultibodyCars):
+            track = st.track
+            vf = 1.0 / (STEPS_PER_PERIOD * CONTACT_STEP)
+            element = float(track.rails[0].length.min())
+            self.irregularity = build_irregularity(scenario, self.vehicle.length,
+                                                   st.girder.length,
+                                                   (track.x_start, track.x_end))
         spacing = self.irregularity.dx if self.irregularity is not None else None
-        dt = scenario.solver.dt or auto_time_step(st.fundamental_frequency,
-                                                  st.girder.element_length, self.speed, vf,
-                                                  spacing)
+        dt = scenario.solver.dt or auto_time_step(st.fundamental_frequency, element,
+                                                  self.speed, vf, spacing)
         rate = scenario.output.rate_hz
         if rate > 0:
             period = 1.0 / rate
@@ -149,13 +211,23 @@ class Simulation:
         self.dt = dt
         self.duration = scenario.solver.duration or self.auto_duration()
         self.n_steps = max(1, math.ceil(self.duration / dt - 1e-9))
+        self.observers = observer_rows(scenario, st)
+        names = tuple(o.name for o in parse_observers(scenario.output.observers))
+        if isinstance(self.vehicle, MultibodyCars):
+            n_bodies, n_axles = self.vehicle.n_cars, 4
+        elif isinstance(self.vehicle, QuarterCars):
+            n_bodies, n_axles = self.vehicle.axles.count, 1
+        else:
+            n_bodies, n_axles = 0, 1
         self.layout = Layout(n_spans=scenario.bridge.n_spans, n_supports=st.n_supports,
-                             n_bodies=self.vehicle.axles.count
-                             if isinstance(self.vehicle, QuarterCars) else 0)
+                             n_bodies=n_bodies, n_axles=n_axles, observers=names)
         self.integrator = Newmark(st.mass, st.damping, st.stiffness, dt)
         self.coupling = (QuarterCarCoupling(self.vehicle, st.girder, self.integrator,
                                             st.n_free)
                          if isinstance(self.vehicle, QuarterCars) else None)
+        self.train_track = (TrainTrackCoupling(scenario, st, self.integrator,
+                                               self.irregularity)
+                            if isinstance(self.vehicle, MultibodyCars) else None)
         log.info('model: %d free DOFs, %d axles, dt = %.3g s, %d steps', st.n_free,
                  self.vehicle.axles.count, dt, self.n_steps)
 
@@ -189,6 +261,9 @@ class Simulation:
             every frame before the failure has already been yielded.
 
         """
+        if self.train_track is not None:
+            yield from self._car_frames()
+            return
         st, nm = self.structure, self.integrator
         n_free, dt = st.n_free, self.dt
         offsets = self.vehicle.axles.offsets
@@ -221,6 +296,41 @@ class Simulation:
                     load_full = self._wheel_load(positions, self.coupling.contact)
                 yield self._frame(step, head, u, v, a, load_full)
 
+    def _car_frames(self) -> Iterator[Frame]:
+        """Step multibody cars on the slab track (see :mod:`ttb_sim.sim.ttbi`)."""
+        tt, dt = self.train_track, self.dt
+        limit = self.scenario.solver.divergence_limit
+        head = self.scenario.train.start_position
+        tt.equilibrium(head)
+        yield self._car_frame(0, head)
+        for step in range(1, self.n_steps + 1):
+            head += self.speed * dt
+            tt.step(head, self.speed)
+            peak = max(float(np.max(np.abs(tt.u))), float(np.max(np.abs(tt.q))))
+            if not math.isfinite(peak) or peak > limit:
+                raise DivergenceError(
+                    f'solution diverged at t = {step * dt:.6g} s (step {step}): largest '
+                    f'displacement {peak:.3g} m exceeds solver.divergence_limit = {limit:g} m '
+                    'or is not finite; try a smaller solver.dt')
+            if step % self.output_every == 0:
+                yield self._car_frame(step, head)
+
+    def _car_frame(self, step: int, head: float) -> Frame:
+        tt, st = self.train_track, self.structure
+        ue, ve, ae = (np.append(x, 0.0) for x in (tt.u, tt.v, tt.a))
+        n = tt.n_cars
+        return Frame(step=step, time=step * self.dt, head_position=head, speed=self.speed,
+                     midspan=ue[st.midspan_dofs],
+                     bearings=bearing_forces(st, ue, ve, ae, np.zeros(st.n_full)),
+                     body_acceleration=tt.qa[:, 0:3].copy(),
+                     body_angular_velocity=tt.qv[:, 3:6].copy(),
+                     wheel_rail=tt.force[..., :3].reshape(n, 4, 2, 3).copy(),
+                     observers=self._observe(ue))
+
+    def _observe(self, ue: np.ndarray) -> np.ndarray:
+        dofs, rows = self.observers
+        return np.einsum('oij,oj->oi', rows, ue[dofs])
+
     def _profile(self, positions: np.ndarray) -> tuple[np.ndarray, ...] | None:
         """Return the centreline vertical irregularity r, r', r'' under the wheels."""
         if self.irregularity is None:
@@ -249,12 +359,12 @@ class Simulation:
         ue, ve, ae = (np.append(x, 0.0) for x in (u, v, a))
         n_b = self.layout.n_bodies
         acc = np.zeros((n_b, 3))
-        contact = np.zeros((n_b, 3))
+        wheel_rail = np.zeros((n_b, 1, 2, 3))
         if self.coupling is not None:
             acc[:, 2] = self.coupling.a
-            contact[:, 2] = self.coupling.contact
+            wheel_rail[:, 0, :, 2] = 0.5 * self.coupling.contact[:, None]
         return Frame(step=step, time=step * self.dt, head_position=head, speed=self.speed,
                      midspan=ue[st.midspan_dofs],
                      bearings=bearing_forces(st, ue, ve, ae, load_full),
                      body_acceleration=acc, body_angular_velocity=np.zeros((n_b, 3)),
-                     contact_force=contact)
+                     wheel_rail=wheel_rail, observers=self._observe(ue))

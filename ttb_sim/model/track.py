@@ -1,0 +1,385 @@
+# Copyright 2026 The ttb_sim Authors
+#
+# Licensed under the Apache License, Version 2.0 (the "License");
+# you may not use this file except in compliance with the License.
+# You may obtain a copy of the License at
+#
+#     http://www.apache.org/licenses/LICENSE-2.0
+#
+# Unless required by applicable law or agreed to in writing, software
+# distributed under the License is distributed on an "AS IS" BASIS,
+# WITHOUT WARRANTIES OR CONDITIONS OF ANY KIND, either express or implied.
+# See the License for the specific language governing permissions and
+# limitations under the License.
+
+"""
+Slab track on the girders and on the approaches ([P] Tables 2 and 4).
+
+Two rails (3-D Euler beams, ``rail_elements_per_bay`` elements per fastener
+bay) sit on discrete fasteners (spring-dashpots in x, y, z plus the pad's
+resistance to rail roll). The fasteners hold the rails on unit track slabs;
+each slab unit carries ``fasteners_per_slab`` fasteners and rests on a base
+plate unit of the same length through a continuous spring-dashpot layer (the
+filling layer). The base plates rest on the girder top through a second
+continuous layer, and on rigid ground on the approaches before and after the
+bridge. Slabs and base plates are 3-D beams whose nodes are the slab ends and
+the fastener positions: PHYSICS.md accepts beams for slab and base below about
+100 Hz; [P] uses Mindlin plates.
+
+Heights (z up from the girder axis): girder top ``girder_top_height``, then the
+base plate, the filling layer, the slab and the rail, stacked; the rails' axes
+are at +/- ``rail_semi_spacing``. On the approaches the ground surface is at the
+girder-top height. Track displacements, like the bridge's, are increments over
+the dead-load state.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+import math
+from typing import Callable
+
+import numpy as np
+
+from ttb_sim.fe.beam import BeamSection, field_rows, NODE_DOFS, offset_rows, point_rows
+from ttb_sim.scenario import TrackConfig
+
+POISSON_CONCRETE = 0.2
+STEEL_DENSITY = 7850.0
+GAUSS_POINTS = 3
+_GX, _GW = np.polynomial.legendre.leggauss(GAUSS_POINTS)
+
+GirderRows = Callable[[np.ndarray, np.ndarray], tuple[np.ndarray, np.ndarray, np.ndarray]]
+"""(x, arm) -> (full DOFs (n, 12), rows (n, 4, 12) of x, y, z, roll; on-girder mask)."""
+
+
+@dataclass(frozen=True)
+class BeamLine:
+    """
+    Elements of one beam along x (possibly in separate units), for point lookups.
+
+    Attributes
+    ----------
+    start : numpy.ndarray
+        (n_el,) x of each element's first node (ascending).
+    length : numpy.ndarray
+        (n_el,) element lengths (m).
+    dofs : numpy.ndarray
+        (n_el, 12) full DOF indices of each element.
+    z : float
+        Height of the beam axis (m).
+    y : float
+        Lateral position of the beam axis (m).
+
+    """
+
+    start: np.ndarray
+    length: np.ndarray
+    dofs: np.ndarray
+    z: float
+    y: float = 0.0
+
+    @property
+    def end(self) -> float:
+        """Return x of the last node (m)."""
+        return float(self.start[-1] + self.length[-1])
+
+    def locate(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """
+        Return (element, xi, inside) for positions x along the track.
+
+        ``inside`` is False in the gaps between units and beyond the ends; the
+        element is then the nearest one to the left (or the first).
+        """
+        x = np.asarray(x, dtype=float)
+        element = np.clip(np.searchsorted(self.start, x, side='right') - 1, 0,
+                          self.start.size - 1)
+        local = x - self.start[element]
+        inside = (local >= 0.0) & (local <= self.length[element] * (1 + 1e-12))
+        xi = np.clip(local / self.length[element], 0.0, 1.0)
+        return element, xi, inside
+
+    def rows(self, x: np.ndarray, arm: np.ndarray,
+             derivative: int = 0) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """
+        Return the rows of the motion of points at ``arm`` from the beam axis.
+
+        Returns
+        -------
+        (element, rows (n, 3, 12), inside); rows are zero outside the beam.
+
+        """
+        element, xi, inside = self.locate(x)
+        r = point_rows(xi, self.length[element], arm, derivative)
+        return element, r * inside[:, None, None], inside
+
+
+@dataclass(frozen=True)
+class LinkSet:
+    """
+    Spring-dashpot links between DOFs: discrete fasteners or quadrature points of a layer.
+
+    Attributes
+    ----------
+    dofs : numpy.ndarray
+        (n, n_local) full DOFs; -1 stands for rigid ground.
+    kinematics : numpy.ndarray
+        (n, 4, n_local) rows of the relative x, y, z displacement and roll.
+    stiffness, damping : numpy.ndarray
+        (n, 4) per direction (N/m, N m/rad; N s/m, N m s/rad), quadrature
+        weights included.
+
+    """
+
+    dofs: np.ndarray
+    kinematics: np.ndarray
+    stiffness: np.ndarray
+    damping: np.ndarray
+
+
+@dataclass(frozen=True)
+class TrackMesh:
+    """
+    The track's share of the structure, before assembly.
+
+    Node and DOF numbers are global (offset by the nodes that precede the
+    track in the structure).
+    """
+
+    coords: np.ndarray
+    """(n_nodes, 3) node coordinates."""
+    elements: np.ndarray
+    """(n_el, 2) global node numbers of each beam element."""
+    sections: BeamSection
+    rails: tuple[BeamLine, BeamLine]
+    """Left (+y) and right (-y) rail."""
+    slab: BeamLine
+    base: BeamLine
+    links: tuple[LinkSet, ...]
+    """Fasteners, the slab-base layer and the base-girder/ground layer."""
+    x_start: float
+    x_end: float
+    rail_head: float
+    """Height of the rail top above the rail axis (m)."""
+    n_fasteners: int
+
+
+def _rect_section(n: int, young: float, width: float, thickness: float, density: float,
+                  extra_mass: float = 0.0) -> BeamSection:
+    """Return the 3-D beam section of a solid rectangle (width along y, thickness along z)."""
+    area = width * thickness
+    iy = width * thickness**3 / 12.0
+    iz = thickness * width**3 / 12.0
+    a, b = max(width, thickness), min(width, thickness)
+    torsion = a * b**3 * (1.0 / 3.0 - 0.21 * b / a * (1.0 - b**4 / (12.0 * a**4)))
+    shear = young / (2.0 * (1.0 + POISSON_CONCRETE))
+    mass = density * area + extra_mass
+    values = (young * area, shear * torsion, young * iy, young * iz, mass,
+              mass / area * (iy + iz))
+    return BeamSection(*(np.full(n, v) for v in values))
+
+
+def approach_length(track: TrackConfig, train_length: float) -> float:
+    """Return the approach length: as set, or the train length + 20 m (m)."""
+    return track.approach_length or (train_length + 20.0)
+
+
+def build_track(track: TrackConfig, bridge_length: float, train_length: float,
+                first_node: int, girder_rows: GirderRows) -> TrackMesh:
+    """
+    Build the track from x = -approach to bridge_length + approach.
+
+    Parameters
+    ----------
+    track : TrackConfig
+        Track keys of the scenario.
+    bridge_length : float
+        Total length of the girders (m); the bridge spans 0 .. bridge_length.
+    train_length : float
+        Length of the train, for the automatic approach length (m).
+    first_node : int
+        Global number of the first track node.
+    girder_rows : callable
+        Point rows of the girder top (see :data:`GirderRows`).
+
+    Returns
+    -------
+    TrackMesh
+
+    """
+    approach = approach_length(track, train_length)
+    s, n_f = track.fastener_spacing, track.fasteners_per_slab
+    pitch = n_f * s
+    margin = 0.5 * (s - track.slab_gap)
+    x0 = -approach
+    n_units = int(math.ceil((bridge_length + 2.0 * approach) / pitch))
+    x1 = x0 + n_units * pitch
+
+    # Heights of the layer stack.
+    h_g = track.girder_top_height
+    z_base = h_g + 0.5 * track.base_thickness
+    z_slab = h_g + track.base_thickness + track.filling_thickness + 0.5 * track.slab_thickness
+    z_rail = z_slab + 0.5 * track.slab_thickness + 0.5 * track.rail_height
+
+    # Fasteners and rail nodes (rails run from the first to the last fastener).
+    unit0 = x0 + np.arange(n_units) * pitch
+    x_fast = (unit0[:, None] + margin + np.arange(n_f)[None, :] * s).ravel()
+    n_e = track.rail_elements_per_bay
+    h = s / n_e
+    n_rail_nodes = (x_fast.size - 1) * n_e + 1
+    x_rail = x_fast[0] + np.arange(n_rail_nodes) * h
+
+    # Slab / base nodes per unit: unit start, the fasteners, unit end.
+    unit_len = pitch - track.slab_gap
+    x_unit = np.concatenate([np.zeros((n_units, 1)),
+                             margin + np.arange(n_f)[None, :] * s * np.ones((n_units, 1)),
+                             np.full((n_units, 1), unit_len)], axis=1) + unit0[:, None]
+    per_unit = n_f + 2
+    x_slab = x_unit.ravel()
+
+    coords, conn, sections = [], [], []
+    node = first_node
+
+    def add_line(x: np.ndarray, y: float, z: float, breaks: int | None) -> np.ndarray:
+        nonlocal node
+        ids = node + np.arange(x.size)
+        coords.append(np.column_stack([x, np.full(x.size, y), np.full(x.size, z)]))
+        pairs = np.column_stack([ids[:-1], ids[1:]])
+        if breaks:
+            keep = (np.arange(x.size - 1) % breaks) != breaks - 1
+            pairs = pairs[keep]
+        conn.append(pairs)
+        node += x.size
+        return ids
+
+    e_r = track.rail_young_modulus
+    rail_ids = []
+    for side in (1.0, -1.0):
+        ids = add_line(x_rail, side * track.rail_semi_spacing, z_rail, None)
+        n = ids.size - 1
+        sections.append(BeamSection(
+            np.full(n, e_r * track.rail_mass / STEEL_DENSITY),
+            np.full(n, track.rail_torsional_stiffness),
+            np.full(n, e_r * track.rail_inertia_y), np.full(n, e_r * track.rail_inertia_z),
+            np.full(n, track.rail_mass),
+            np.full(n, STEEL_DENSITY * track.rail_polar_inertia)))
+        rail_ids.append(ids)
+    fill_mass = 0.5 * track.concrete_density * track.slab_width * track.filling_thickness
+    slab_ids = add_line(x_slab, 0.0, z_slab, per_unit)
+    sections.append(_rect_section(conn[-1].shape[0], track.slab_young_modulus,
+                                  track.slab_width, track.slab_thickness,
+                                  track.concrete_density, fill_mass))
+    base_ids = add_line(x_slab, 0.0, z_base, per_unit)
+    sections.append(_rect_section(conn[-1].shape[0], track.base_young_modulus,
+                                  track.base_width, track.base_thickness,
+                                  track.concrete_density, fill_mass))
+    coords_all = np.concatenate(coords)
+    elements = np.concatenate(conn)
+    section = BeamSection(*(np.concatenate([getattr(sec, f) for sec in sections])
+                            for f in ('ea', 'gj', 'ei_y', 'ei_z', 'mass', 'inertia_x')))
+
+    def line(ids: np.ndarray, pairs: np.ndarray, y: float, z: float) -> BeamLine:
+        start = coords_all[pairs[:, 0] - first_node, 0]
+        length = coords_all[pairs[:, 1] - first_node, 0] - start
+        dofs = (pairs[:, :, None] * NODE_DOFS + np.arange(NODE_DOFS)).reshape(-1, 12)
+        return BeamLine(start, length, dofs, z, y)
+
+    rails = (line(rail_ids[0], conn[0], track.rail_semi_spacing, z_rail),
+             line(rail_ids[1], conn[1], -track.rail_semi_spacing, z_rail))
+    slab = line(slab_ids, conn[2], 0.0, z_slab)
+    base = line(base_ids, conn[3], 0.0, z_base)
+
+    # Fasteners: rail foot on the slab top, one per rail and fastener position.
+    fast_rail_node = np.arange(x_fast.size) * n_e
+    fast_slab_node = (np.arange(n_units)[:, None] * per_unit + 1 + np.arange(n_f)).ravel()
+    dofs_f, kin_f = [], []
+    for r, side in enumerate((1.0, -1.0)):
+        a = rail_ids[r][fast_rail_node]
+        b = slab_ids[fast_slab_node]
+        arm_a = np.array([0.0, 0.0, -0.5 * track.rail_height])
+        arm_b = np.array([0.0, side * track.rail_semi_spacing, 0.5 * track.slab_thickness])
+        dofs_f.append(np.concatenate([_node_dofs(a), _node_dofs(b)], axis=1))
+        kin_f.append(np.broadcast_to(_node_link(arm_a, arm_b), (a.size, 4, 12)))
+    n_fast = 2 * x_fast.size
+    kf = np.tile([track.fastener_longitudinal_stiffness, track.fastener_lateral_stiffness,
+                  track.fastener_vertical_stiffness,
+                  track.fastener_vertical_stiffness * track.rail_foot_width**2 / 12.0],
+                 (n_fast, 1))
+    cf = np.tile([track.fastener_lateral_damping, track.fastener_lateral_damping,
+                  track.fastener_vertical_damping, 0.0], (n_fast, 1))
+
+    # Continuous layers, integrated by Gauss quadrature over the upper beam's elements.
+    k_l, c_l = track.layer_stiffness, track.layer_damping
+    slab_base = _layer(slab, np.array([0.0, 0.0, -0.5 * track.slab_thickness]),
+                       _line_rows(base, np.array([0.0, 0.0, 0.5 * track.base_thickness])),
+                       k_l, c_l, track.slab_width)
+    base_girder = _layer(base, np.array([0.0, 0.0, -0.5 * track.base_thickness]),
+                         lambda x: girder_rows(x, np.array([0.0, 0.0, h_g])),
+                         k_l, c_l, track.base_width)
+    fasteners = LinkSet(np.concatenate(dofs_f), np.concatenate(kin_f), kf, cf)
+    return TrackMesh(coords=coords_all, elements=elements, sections=section, rails=rails,
+                     slab=slab, base=base, links=(fasteners, slab_base, base_girder),
+                     x_start=x0, x_end=x1,
+                     rail_head=0.5 * track.rail_height, n_fasteners=int(x_fast.size))
+
+
+def _node_dofs(nodes: np.ndarray) -> np.ndarray:
+    return nodes[:, None] * NODE_DOFS + np.arange(NODE_DOFS)
+
+
+def _node_link(arm_a: np.ndarray, arm_b: np.ndarray) -> np.ndarray:
+    """Return (4, 12) rows of the relative motion and roll of two nodes' arm tips."""
+    return np.concatenate([_arm_rows(arm_a), -_arm_rows(arm_b)], axis=1)
+
+
+def _arm_rows(arm: np.ndarray) -> np.ndarray:
+    """Return (4, 6) rows of a node's arm tip motion (x, y, z) and its roll."""
+    f = np.zeros((1, 6, 12))
+    f[0, :, :6] = np.eye(6)
+    rows = np.zeros((4, 6))
+    rows[:3] = offset_rows(f, arm)[0, :, :6]
+    rows[3, 3] = 1.0
+    return rows
+
+
+def _line_rows(line: BeamLine, arm: np.ndarray
+               ) -> Callable[[np.ndarray], tuple[np.ndarray, np.ndarray, np.ndarray]]:
+    """Return x -> (full DOFs, rows (n, 4, 12), inside) for points of a beam line."""
+    def rows(x: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        element, xi, inside = line.locate(x)
+        f = field_rows(xi, line.length[element])
+        out = np.concatenate([offset_rows(f, arm), f[:, 3:4, :]], axis=1)
+        return line.dofs[element], out * inside[:, None, None], inside
+    return rows
+
+
+def _layer(upper: BeamLine, arm: np.ndarray,
+           lower: Callable[[np.ndarray], tuple[np.ndarray, np.ndarray, np.ndarray]],
+           stiffness: float, damping: float, width: float) -> LinkSet:
+    """
+    Integrate a continuous spring-dashpot layer under every element of ``upper``.
+
+    The layer resists relative x, y, z motion with ``stiffness`` per metre of
+    track (x assumed equal to y) and relative roll with stiffness * width^2 / 12
+    (vertical springs spread over the width). Where ``lower`` reports no beam,
+    the layer rests on rigid ground.
+
+    Returns
+    -------
+    LinkSet
+        One link per quadrature point, over 24 DOFs (upper element, lower).
+
+    """
+    n_el = upper.start.size
+    xi = np.tile(0.5 * (_GX + 1.0), n_el)
+    element = np.repeat(np.arange(n_el), GAUSS_POINTS)
+    weight = np.tile(0.5 * _GW, n_el) * upper.length[element]
+    x = upper.start[element] + xi * upper.length[element]
+    f = field_rows(xi, upper.length[element])
+    rows_a = np.concatenate([offset_rows(f, arm), f[:, 3:4, :]], axis=1)
+    dofs_b, rows_b, on = lower(x)
+    dofs = np.concatenate([upper.dofs[element], np.where(on[:, None], dofs_b, -1)], axis=1)
+    kin = np.concatenate([rows_a, -rows_b], axis=2)
+    per_length = np.array([1.0, 1.0, 1.0, width**2 / 12.0])
+    return LinkSet(dofs, kin, weight[:, None] * stiffness * per_length,
+                   weight[:, None] * damping * per_length)

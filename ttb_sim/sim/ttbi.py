@@ -1,0 +1,513 @@
+# Copyright 2026 The ttb_sim Authors
+#
+# Licensed under the Apache License, Version 2.0 (the "License");
+# you may not use this file except in compliance with the License.
+# You may obtain a copy of the License at
+#
+#     http://www.apache.org/licenses/LICENSE-2.0
+#
+# Unless required by applicable law or agreed to in writing, software
+# distributed under the License is distributed on an "AS IS" BASIS,
+# WITHOUT WARRANTIES OR CONDITIONS OF ANY KIND, either express or implied.
+# See the License for the specific language governing permissions and
+# limitations under the License.
+
+"""
+Train-track-bridge interaction: multibody cars on the rails, solved in each step.
+
+Both subsystems use Newmark's average-acceleration method with constant
+effective matrices: the track-bridge matrix K + 2/dt C + 4/dt^2 M (sparse,
+factorised once) and, per car, A = K + 2/dt (C + G(V)) + 4/dt^2 M (42 x 42,
+inverted once per speed). At the end of a step both states are affine in the
+contact forces g = (Fx, Fy, Fz, Mz) of the 8 wheels of every car (force of the
+rail on the wheel, track axes):
+
+* wheel contact points: w = w* + H A^-1 H^T g (exact, per car);
+* rail head under each wheel: r = r* - R K^-1 R^T g. The effective track matrix
+  is dominated by 4/dt^2 M, so its inverse is local: the rail's compliance at a
+  wheel is the 12 x 12 block of K^-1 over the rail element under it (computed
+  once by probing), and wheels (>= 2.5 m apart) do not see each other inside
+  one step.
+
+The contact laws close the system: Hertz's normal force on the vertical
+compression (Newton iteration), Kalker's linear creep forces on the creepages
+(which are affine in the end-of-step velocities, so they are implicit too),
+with the Shen-Hedrick-Elkins saturation factor, the creep coefficients' load
+scaling and the contact geometry (rolling radii, contact angles) taken from the
+previous step. After the Newton iteration the track is solved exactly with
+those forces and the rail displacement under every wheel is compared with the
+local prediction; any mismatch above ``contact.tolerance`` is fed back and the
+iteration repeated, so each step's contact forces satisfy the contact laws on
+the exact track response to that tolerance.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+import logging
+import math
+
+import numpy as np
+import scipy.sparse.linalg as sla
+
+from ttb_sim.errors import DivergenceError
+from ttb_sim.fe.beam import point_rows
+from ttb_sim.model import contact as ct
+from ttb_sim.model.bridge import Structure
+from ttb_sim.model.car import CarParameters, dofs as car_dofs, gyroscopic_matrix, train_matrices
+from ttb_sim.model.irregularity import TrackIrregularity
+from ttb_sim.model.profiles import contact_geometry_table
+from ttb_sim.model.track import BeamLine
+from ttb_sim.scenario import Scenario
+from ttb_sim.sim.newmark import Newmark
+
+log = logging.getLogger(__name__)
+
+PROBE_SPACING = 24
+"""Rail nodes between simultaneous probes of the local track compliance."""
+COMPONENTS = 4
+"""Contact force components per wheel: Fx, Fy, Fz (on the wheel), Mz (spin moment)."""
+
+
+def car_parameters(scenario: Scenario) -> CarParameters:
+    """Return the car parameters of a scenario's ``car`` and ``train`` sections."""
+    c, t = scenario.car, scenario.train
+    return CarParameters(
+        car_body_mass=c.car_body_mass, bogie_mass=c.bogie_mass, wheelset_mass=c.wheelset_mass,
+        car_body_roll_inertia=c.car_body_roll_inertia,
+        car_body_pitch_inertia=c.car_body_pitch_inertia,
+        car_body_yaw_inertia=c.car_body_yaw_inertia,
+        bogie_roll_inertia=c.bogie_roll_inertia, bogie_pitch_inertia=c.bogie_pitch_inertia,
+        bogie_yaw_inertia=c.bogie_yaw_inertia, wheelset_roll_inertia=c.wheelset_roll_inertia,
+        wheelset_pitch_inertia=c.wheelset_spin_inertia,
+        wheelset_yaw_inertia=c.wheelset_yaw_inertia,
+        primary_stiffness_x=c.primary_stiffness_x, primary_stiffness_y=c.primary_stiffness_y,
+        primary_stiffness_z=c.primary_stiffness_z,
+        secondary_stiffness_x=c.secondary_stiffness_x,
+        secondary_stiffness_y=c.secondary_stiffness_y,
+        secondary_stiffness_z=c.secondary_stiffness_z,
+        primary_damping_z=c.primary_damping_z, secondary_damping_y=c.secondary_damping_y,
+        secondary_damping_z=c.secondary_damping_z,
+        n_primary_vertical_dampers=c.primary_vertical_dampers,
+        n_secondary_vertical_dampers=c.secondary_vertical_dampers,
+        n_secondary_lateral_dampers=c.secondary_lateral_dampers,
+        bogie_semi_distance=t.bogie_semi_spacing, axle_semi_distance=t.wheelbase_semi,
+        wheel_radius=c.wheel_radius, contact_semi_distance=c.contact_semi_distance)
+
+
+@dataclass(frozen=True)
+class ContactState:
+    """Contact quantities of every wheel at the end of a step, shape (n_cars, 8, ...)."""
+
+    force: np.ndarray
+    """(n_cars, 8, 4) Fx, Fy, Fz (N) and Mz (N m) of the rail on the wheel."""
+    compression: np.ndarray
+    """(n_cars, 8) Hertz compression (m)."""
+    iterations: int
+    """Newton iterations of the step (all cars)."""
+
+
+class RailCompliance:
+    """
+    Local blocks of the inverse effective track matrix over each rail element.
+
+    Parameters
+    ----------
+    integrator : Newmark
+        The factorised track-bridge system.
+    rails : tuple of BeamLine
+        Left and right rail (full DOFs).
+    full_to_free : numpy.ndarray
+        Extended free index of each full DOF.
+
+    """
+
+    def __init__(self, integrator: Newmark, rails: tuple[BeamLine, ...],
+                 full_to_free: np.ndarray) -> None:
+        n_free = integrator.mass.shape[0]
+        self.blocks = []
+        for rail in rails:
+            dofs = full_to_free[rail.dofs]                     # (n_el, 12)
+            nodes = np.vstack([dofs[:, :6], dofs[-1:, 6:]])    # (n_nodes, 6)
+            n_nodes = nodes.shape[0]
+            # cols[i, j, :] = K^-1 column of node i, DOF j, restricted to nodes i-1..i+1.
+            local = np.zeros((n_nodes, 6, 3, 6))
+            for offset in range(PROBE_SPACING):
+                probe = np.arange(offset, n_nodes, PROBE_SPACING)
+                rhs = np.zeros((n_free + 1, 6))
+                for j in range(6):
+                    rhs[nodes[probe, j], j] = 1.0
+                sol = np.vstack([integrator.solve(rhs[:n_free]), np.zeros((1, 6))])
+                for k, shift in enumerate((-1, 0, 1)):
+                    at = np.clip(probe + shift, 0, n_nodes - 1)
+                    local[probe, :, k, :] = sol[nodes[at]].transpose(0, 2, 1)
+            # Element block B[e] over (node e, node e+1) x (node e, node e+1).
+            n_el = n_nodes - 1
+            b = np.zeros((n_el, 12, 12))
+            e = np.arange(n_el)
+            b[:, :6, :6] = local[e, :, 1, :].transpose(0, 2, 1)
+            b[:, 6:, :6] = local[e, :, 2, :].transpose(0, 2, 1)
+            b[:, :6, 6:] = local[e + 1, :, 0, :].transpose(0, 2, 1)
+            b[:, 6:, 6:] = local[e + 1, :, 1, :].transpose(0, 2, 1)
+            self.blocks.append(0.5 * (b + b.transpose(0, 2, 1)))
+
+
+class TrainTrackCoupling:
+    """
+    State and coupled step of multibody cars running on the slab track.
+
+    Parameters
+    ----------
+    scenario : Scenario
+        A validated scenario with ``train.vehicle = car``.
+    structure : Structure
+        The assembled track and bridge (with ``structure.track``).
+    integrator : Newmark
+        The track-bridge integrator (its dt is the step).
+    irregularity : TrackIrregularity or None
+        The track's irregularity (None = smooth).
+
+    """
+
+    def __init__(self, scenario: Scenario, structure: Structure, integrator: Newmark,
+                 irregularity: TrackIrregularity | None) -> None:
+        self.scenario = scenario
+        self.structure = structure
+        self.nm = integrator
+        self.irregularity = irregularity
+        self.params = car_parameters(scenario)
+        p = self.params
+        tm = train_matrices(p, scenario.train.n_cars, scenario.train.car_length)
+        self.n_cars = tm.n_cars
+        self.train = tm
+        n = self.n_cars
+        self.mass = tm.mass[:42, :42].toarray()
+        self.damping = tm.damping[:42, :42].toarray()
+        self.stiffness = tm.stiffness[:42, :42].toarray()
+        self.gravity = tm.gravity[:42].copy()
+        h = np.zeros((8, COMPONENTS, 42))
+        h[:, 0] = tm.hx[:8, :42].toarray()
+        h[:, 1] = tm.hy[:8, :42].toarray()
+        h[:, 2] = tm.hz[:8, :42].toarray()
+        h[:, 3] = tm.hyaw[:8, :42].toarray()
+        self.h = h.reshape(8 * COMPONENTS, 42)
+        self.contact_x = tm.contact_x.reshape(n, 8)
+        self.side = tm.contact_side.reshape(n, 8)
+        self.r0 = p.wheel_radius
+        cc = scenario.contact
+        self.g_hertz = float(ct.hertz_constant(p.wheel_radius, cc.tread))
+        self.friction = cc.friction
+        self.p0 = p.static_wheel_load
+        ellipse = ct.hertz_ellipse(self.p0, p.wheel_radius)
+        self.creep0 = ct.creep_coefficients(ellipse.a, ellipse.b)
+        if cc.geometry == 'profiles':
+            self.table = contact_geometry_table()
+        else:
+            self.table = None
+        track = structure.track
+        self.track = track
+        self.rails = track.rails
+        self.head_arm = np.array([0.0, 0.0, track.rail_head])
+        ftf = structure.full_to_free
+        self.rail_dofs = tuple(ftf[r.dofs] for r in self.rails)
+        self.compliance = RailCompliance(integrator, self.rails, ftf)
+        self._speed = math.nan
+        self.tol = cc.tolerance
+        self.max_iter = cc.max_iterations
+        n_free = structure.n_free
+        self.u = np.zeros(n_free)
+        self.v = np.zeros(n_free)
+        self.a = np.zeros(n_free)
+        self.q = np.zeros((n, 42))
+        self.qv = np.zeros((n, 42))
+        self.qa = np.zeros((n, 42))
+        self.force = np.zeros((n, 8, COMPONENTS))
+        self.compression = np.zeros((n, 8))
+        self.saturation = np.ones((n, 8))
+        self.iterations = 0
+        self._rail_y = np.zeros((n, 8))
+        self._wheelset_y = 6 * np.repeat(np.arange(3, 7), 2) + 1
+
+    # -- geometry and kinematics ---------------------------------------------------------
+    def _rail_rows(self, x: np.ndarray
+                   ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """Return rail-head rows R, R' (n_cars, 8, 3, 12), ext-free DOFs and B blocks."""
+        shape = x.shape
+        rows = np.zeros(shape + (3, 12))
+        slope = np.zeros(shape + (3, 12))
+        dofs = np.zeros(shape + (12,), dtype=int)
+        blocks = np.zeros(shape + (12, 12))
+        for r, side in enumerate((1.0, -1.0)):
+            sel = self.side == side
+            rail = self.rails[r]
+            element, xi, inside = rail.locate(x[sel])
+            if not np.all(inside):
+                raise DivergenceError('a wheel ran off the modelled track at x = '
+                                      f'{x[sel][~inside][0]:.2f} m; the run is longer than '
+                                      'the track (check solver.duration)')
+            rows[sel] = point_rows(xi, rail.length[element], self.head_arm)
+            slope[sel] = point_rows(xi, rail.length[element], self.head_arm, 1)
+            dofs[sel] = self.rail_dofs[r][element]
+            blocks[sel] = self.compliance.blocks[r][element]
+        return rows, slope, dofs, blocks
+
+    def _irregularity(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Return vertical and lateral rail irregularity and lateral slope under each wheel."""
+        z = np.zeros_like(x)
+        y = np.zeros_like(x)
+        dy = np.zeros_like(x)
+        if self.irregularity is None:
+            return z, y, dy
+        s = self.irregularity.sample(x, outside='zero')
+        left = self.side > 0
+        z = np.where(left, s.value[0], s.value[1])
+        y = np.where(left, s.value[2], s.value[3])
+        dy = np.where(left, s.slope[2], s.slope[3])
+        return z, y, dy
+
+    def _geometry(self, lateral: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Return rolling radius and contact angle of each wheel at relative shifts."""
+        if self.table is not None:
+            g = self.table.wheelset_geometry(lateral)
+        else:
+            g = ct.simplified_geometry(lateral, self.scenario.contact.conicity, self.r0)
+        left = self.side > 0
+        radius = np.where(left, g.rolling_radius[..., 0], g.rolling_radius[..., 1])
+        angle = np.where(left, g.contact_angle[..., 0], g.contact_angle[..., 1])
+        return radius, angle
+
+    # -- train matrices -----------------------------------------------------------------
+    def _update_speed(self, speed: float) -> None:
+        if speed == self._speed:
+            return
+        nm = self.nm
+        damping = self.damping + gyroscopic_matrix(self.params, speed)
+        self.train_damping = damping
+        eff = self.stiffness + nm.a1 * damping + nm.a0 * self.mass
+        self.a_inv = np.linalg.inv(eff)
+        self.dw = self.h @ self.a_inv @ self.h.T
+        self._speed = speed
+
+    # -- static equilibrium -------------------------------------------------------------
+    def equilibrium(self, head: float) -> None:
+        """
+        Put train and track in static equilibrium under gravity at a head position.
+
+        Vertical problem only (the train is symmetric and the track straight):
+        Newton on the car DOFs and the wheel loads, with the exact static track
+        flexibility under the wheels (one static factorisation, one solve per wheel).
+        """
+        st = self.structure
+        n = self.n_cars
+        x = head + self.contact_x
+        rows, _, dofs, _ = self._rail_rows(x)
+        irr_z, _, _ = self._irregularity(x)
+        n_free = st.n_free
+        m = 8 * n
+        lu = sla.splu(st.stiffness.tocsc())
+        rhs = np.zeros((n_free + 1, m))
+        flat = dofs.reshape(m, 12)
+        rz = rows[..., 2, :].reshape(m, 12)
+        rhs[flat, np.arange(m)[:, None]] = rz
+        zcol = np.vstack([lu.solve(rhs[:n_free]), np.zeros((1, m))])
+        flex = np.einsum('ik,ikj->ij', rz, zcol[flat])     # r_z = -flex @ P
+        # Vertical subproblem: z, roll, pitch of body and bogies; z, roll of the
+        # wheelsets (their pitch is the free spin).
+        sub = np.sort(np.concatenate([car_dofs(range(3), ['z', 'roll', 'pitch']),
+                                      car_dofs(range(3, 7), ['z', 'roll'])]))
+        k_sub = self.stiffness[np.ix_(sub, sub)]
+        hz = self.h.reshape(8, COMPONENTS, 42)[:, 2][:, sub]      # (8, n_sub)
+        g_sub = self.gravity[sub]
+        n_sub = sub.size
+        q = np.zeros((n, n_sub))
+        load = np.full(m, self.p0)
+        # Below a quarter of the static compression the Hertz law is continued by its
+        # tangent, so that Newton starts from an unloaded train; the converged state
+        # lies on the Hertz law itself.
+        d_min = 0.25 * float(ct.static_compression(self.p0, self.g_hertz))
+        f_min = float(ct.normal_force(d_min, self.g_hertz))
+        k_min = float(ct.normal_force_derivative(d_min, self.g_hertz))
+        for _ in range(60):
+            w = np.einsum('ks,cs->ck', hz, q).ravel()
+            delta = -flex @ load + irr_z.ravel() - w
+            low = delta < d_min
+            f = np.where(low, f_min + k_min * (delta - d_min),
+                         ct.normal_force(np.maximum(delta, d_min), self.g_hertz))
+            kh = np.where(low, k_min,
+                          ct.normal_force_derivative(np.maximum(delta, d_min), self.g_hertz))
+            # Residuals: K q - hz^T P - g = 0 ; P - f(delta) = 0.
+            r1 = (q @ k_sub.T) - np.einsum('ks,ck->cs', hz, load.reshape(n, 8)) - g_sub
+            r2 = load - f
+            size = n * n_sub + m
+            jac = np.zeros((size, size))
+            for c in range(n):
+                s = slice(c * n_sub, (c + 1) * n_sub)
+                jac[s, s] = k_sub
+                jac[s, n * n_sub + 8 * c:n * n_sub + 8 * c + 8] = -hz.T
+                rows_c = slice(n * n_sub + 8 * c, n * n_sub + 8 * c + 8)
+                jac[rows_c, s] = kh[8 * c:8 * c + 8, None] * hz
+            jac[n * n_sub:, n * n_sub:] = np.eye(m) + kh[:, None] * flex
+            step = np.linalg.solve(jac, -np.concatenate([r1.ravel(), r2]))
+            q += step[:n * n_sub].reshape(n, n_sub)
+            load += step[n * n_sub:]
+            if np.max(np.abs(step[n * n_sub:])) < 1e-6 * self.p0:
+                break
+        else:
+            raise DivergenceError('static equilibrium of the train on the track did not '
+                                  'converge in 60 Newton iterations')
+        self.q[:, sub] = q
+        self.qv[:] = 0.0
+        self.qa[:] = 0.0
+        self.u = -(zcol[:n_free] @ load)
+        self.v[:] = 0.0
+        self.a[:] = 0.0
+        self.force[:] = 0.0
+        self.force[..., 2] = load.reshape(n, 8)
+        w = np.einsum('ks,cs->ck', hz, q)
+        self.compression = (-(flex @ load) + irr_z.ravel() - w.ravel()).reshape(n, 8)
+        self.saturation[:] = 1.0
+        log.info('static equilibrium: wheel loads %.1f .. %.1f kN', load.min() / 1e3,
+                 load.max() / 1e3)
+
+    # -- one step -------------------------------------------------------------------------
+    def step(self, head: float, speed: float) -> None:
+        """Advance train, track and bridge together to the head position ``head``."""
+        self._update_speed(speed)
+        nm, n = self.nm, self.n_cars
+        n_free = self.structure.n_free
+        x = head + self.contact_x
+        rows, slope, dofs, blocks = self._rail_rows(x)
+        irr_z, irr_y, irr_dy = self._irregularity(x)
+
+        # Predictors (no contact force).
+        h_v, h_a = nm.history(self.u, self.v, self.a)
+        u_star = nm.solve(nm.effective_load(np.zeros(n_free), h_v, h_a))
+        ue = np.append(u_star, 0.0)
+        hve = np.append(h_v, 0.0)
+        r_star = np.einsum('cwij,cwj->cwi', rows, ue[dofs])
+        rs_star = np.einsum('cwij,cwj->cwi', slope, ue[dofs])
+        r_hist = np.einsum('cwij,cwj->cwi', rows, hve[dofs])
+        a0, a1 = nm.a0, nm.a1
+        qh_v = -a1 * self.q - self.qv
+        qh_a = -a0 * self.q - 2.0 * a1 * self.qv - self.qa
+        rhs_t = self.gravity - qh_a @ self.mass.T - qh_v @ self.train_damping.T
+        q_star = rhs_t @ self.a_inv.T
+        w_star = (q_star @ self.h.T).reshape(n, 8, COMPONENTS)
+        w_hist = (qh_v @ self.h.T).reshape(n, 8, COMPONENTS)
+
+        # Local rail compliance: r = r* - Dr g_xyz, r' = r'* - Ds g_xyz.
+        dr = np.einsum('cwij,cwjk,cwlk->cwil', rows, blocks, rows)
+        ds = np.einsum('cwij,cwjk,cwlk->cwil', slope, blocks, rows)
+
+        # Lagged contact geometry and creep coefficients.
+        y_rel = self.q[:, self._wheelset_y] - self._rail_y - irr_y
+        radius, angle = self._geometry(y_rel)
+        normal = np.maximum(self.force[..., 2], 0.0)
+        f11, f22, f23, f33 = ct.scale_creep_coefficients(self.creep0, self.p0, normal)
+        eps = self.saturation
+        side = self.side
+        tan_g = np.tan(angle)
+        dr_rad = radius - self.r0
+
+        # Affine maps of the end-of-step quantities in g (per car, 32 unknowns).
+        m = 8 * COMPONENTS
+        eye = np.eye(m)
+        dwm = np.broadcast_to(self.dw, (n, m, m))                # wheel: w = w* + Dw g
+        rail_disp = np.zeros((n, m, m))                          # rail: r = r* - Rm g
+        rail_vel = np.zeros((n, m, m))
+        idx = np.arange(8) * COMPONENTS
+        for i in range(3):
+            for j in range(3):
+                rail_disp[:, idx + i, idx + j] = dr[..., i, j]
+                rail_vel[:, idx + i, idx + j] = a1 * dr[..., i, j] + speed * ds[..., i, j]
+        w0 = w_star.reshape(n, m)
+        wv0 = a1 * w0 + w_hist.reshape(n, m)
+        r0p = np.zeros((n, 8, COMPONENTS))
+        r0p[..., :3] = r_star
+        rv0 = np.zeros((n, 8, COMPONENTS))
+        rv0[..., :3] = a1 * r_star + r_hist + speed * rs_star
+        offset = np.zeros((n, 8, COMPONENTS))
+        # Sensitivities of compression and creepages to g (constant within the step).
+
+        def part(mat: np.ndarray, k: int) -> np.ndarray:
+            return mat.reshape(n, 8, COMPONENTS, m)[:, :, k]
+
+        def value(vec: np.ndarray, k: int) -> np.ndarray:
+            return vec.reshape(n, 8, COMPONENTS)[..., k]
+
+        cosg, sing = np.cos(angle), np.sin(angle)
+        d_delta = -part(rail_disp, 2) - part(dwm, 2)
+        d_xi_x = (a1 * part(dwm, 0) + part(rail_vel, 0)) / speed
+        d_xi_y = (a1 * part(dwm, 1) + part(rail_vel, 1)) / speed - part(dwm, 3)
+        d_xi_sp = a1 * part(dwm, 3) * cosg[..., None] / speed
+        creep_x = -(eps * f11)[..., None] * d_xi_x
+        creep_y = -(eps * f22)[..., None] * d_xi_y - (eps * f23)[..., None] * d_xi_sp
+        creep_m = (eps * f23)[..., None] * d_xi_y - (eps * f33)[..., None] * d_xi_sp
+        g = self.force.reshape(n, m).copy()
+        total_iter = 0
+        change = math.inf
+        for _outer in range(self.max_iter):
+            rp = (r0p + offset).reshape(n, m)
+            rvp = (rv0 + a1 * offset).reshape(n, m)
+            for _ in range(self.max_iter):
+                total_iter += 1
+                w = w0 + np.einsum('cij,cj->ci', dwm, g)
+                wv = wv0 + a1 * np.einsum('cij,cj->ci', dwm, g)
+                r = rp - np.einsum('cij,cj->ci', rail_disp, g)
+                rv = rvp - np.einsum('cij,cj->ci', rail_vel, g)
+                delta = value(r, 2) + irr_z - value(w, 2) + dr_rad
+                fz = ct.normal_force(delta, self.g_hertz)
+                kh = ct.normal_force_derivative(delta, self.g_hertz)
+                xi_x = (value(wv, 0) - value(rv, 0)) / speed + 1.0 - radius / self.r0
+                xi_y = (value(wv, 1) - value(rv, 1) - speed * irr_dy) / speed - value(w, 3)
+                xi_sp = value(wv, 3) * cosg / speed - side * sing / self.r0
+                fx = -eps * f11 * xi_x
+                fy = -eps * (f22 * xi_y + f23 * xi_sp) - side * tan_g * fz
+                mz = eps * (f23 * xi_y - f33 * xi_sp)
+                target = np.stack([fx, fy, fz, mz], axis=-1).reshape(n, m)
+                jac_f = np.stack([creep_x,
+                                  creep_y - (side * tan_g * kh)[..., None] * d_delta,
+                                  kh[..., None] * d_delta, creep_m], axis=2).reshape(n, m, m)
+                dg = np.linalg.solve(eye - jac_f, (target - g)[..., None])[..., 0]
+                g = g + dg
+                change = float(np.max(np.abs(np.einsum('cwj,cj->cw', d_delta, dg))))
+                if change < self.tol:
+                    break
+            else:
+                raise DivergenceError(f'contact iteration did not converge in {self.max_iter} '
+                                      f'iterations (last change {change:.3g} m)')
+            # Exact track response to these forces.
+            gx = g.reshape(n, 8, COMPONENTS)[..., :3]
+            load = np.zeros(n_free + 1)
+            np.add.at(load, dofs.ravel(), -np.einsum('cwij,cwi->cwj', rows, gx).ravel())
+            u_new = u_star + nm.solve(load[:n_free])
+            ue = np.append(u_new, 0.0)
+            r_exact = np.einsum('cwij,cwj->cwi', rows, ue[dofs])
+            r_model = rp.reshape(n, 8, COMPONENTS)[..., :3] - np.einsum(
+                'cwij,cwj->cwi', dr, gx)
+            mismatch = r_exact - r_model
+            if np.max(np.abs(mismatch[..., 2])) <= self.tol:
+                break
+            offset[..., :3] += mismatch
+        else:
+            raise DivergenceError('rail displacement under the wheels did not converge to '
+                                  f'contact.tolerance = {self.tol:g} m')
+
+        # Accept the step.
+        g3 = g.reshape(n, 8, COMPONENTS)
+        q_new = q_star + (g @ self.h) @ self.a_inv.T
+        self.qv = a1 * q_new + qh_v
+        self.qa = a0 * q_new + qh_a
+        self.q = q_new
+        self.v, self.a = nm.finish(u_new, h_v, h_a)
+        self.u = u_new
+        self.force = g3
+        self.compression = delta
+        self._rail_y = r_exact[..., 1]
+        lin = np.hypot(-f11 * xi_x, -(f22 * xi_y + f23 * xi_sp))
+        limit = self.friction * np.maximum(fz, 1e-9)
+        beta = lin / limit
+        with np.errstate(divide='ignore', invalid='ignore'):
+            self.saturation = np.where(beta > 1e-12, ct.she_ratio(beta) / beta, 1.0)
+        self.saturation = np.where(fz > 0.0, self.saturation, 0.0)
+        self.iterations = total_iter
