@@ -29,12 +29,13 @@ rail on the wheel, track axes):
   once by probing), and wheels (>= 2.5 m apart) do not see each other inside
   one step.
 
-The contact laws close the system: Hertz's normal force on the vertical
-compression (Newton iteration), Kalker's linear creep forces on the creepages
-(which are affine in the end-of-step velocities, so they are implicit too),
-with the Shen-Hedrick-Elkins saturation factor, the creep coefficients' load
-scaling and the contact geometry (rolling radii, contact angles) taken from the
-previous step. After the Newton iteration the track is solved exactly with
+The contact laws close the system, all at the end of the step: Hertz's normal
+force on the vertical compression, the contact geometry (rolling radius and
+contact angle from the profile table at the wheelset's lateral position
+relative to the rail) and Kalker's linear creep forces on the creepages, which
+are affine in the end-of-step velocities. A Newton iteration solves them; only
+the Shen-Hedrick-Elkins saturation factor and the load scaling of the creep
+coefficients are taken from the previous step (an explicit lag of O(dt)). After the Newton iteration the track is solved exactly with
 those forces and the rail displacement under every wheel is compared with the
 local prediction; any mismatch above ``contact.tolerance`` is fed back and the
 iteration repeated, so each step's contact forces satisfy the contact laws on
@@ -66,6 +67,8 @@ log = logging.getLogger(__name__)
 PROBE_SPACING = 24
 """Rail nodes between simultaneous probes of the local track compliance."""
 COMPONENTS = 4
+GEOMETRY_STEP = 1e-6
+"""Lateral step (m) of the central difference of the rolling radius."""
 """Contact force components per wheel: Fx, Fy, Fz (on the wheel), Mz (spin moment)."""
 
 
@@ -286,6 +289,7 @@ class TrainTrackCoupling:
         eff = self.stiffness + nm.a1 * damping + nm.a0 * self.mass
         self.a_inv = np.linalg.inv(eff)
         self.dw = self.h @ self.a_inv @ self.h.T
+        self.ey = (self.a_inv @ self.h.T)[self._wheelset_y]
         self._speed = speed
 
     # -- static equilibrium -------------------------------------------------------------
@@ -399,15 +403,11 @@ class TrainTrackCoupling:
         dr = np.einsum('cwij,cwjk,cwlk->cwil', rows, blocks, rows)
         ds = np.einsum('cwij,cwjk,cwlk->cwil', slope, blocks, rows)
 
-        # Lagged contact geometry and creep coefficients.
-        y_rel = self.q[:, self._wheelset_y] - self._rail_y - irr_y
-        radius, angle = self._geometry(y_rel)
+        # Creep coefficients (load scaling) and saturation from the previous step.
         normal = np.maximum(self.force[..., 2], 0.0)
         f11, f22, f23, f33 = ct.scale_creep_coefficients(self.creep0, self.p0, normal)
         eps = self.saturation
         side = self.side
-        tan_g = np.tan(angle)
-        dr_rad = radius - self.r0
 
         # Affine maps of the end-of-step quantities in g (per car, 32 unknowns).
         m = 8 * COMPONENTS
@@ -435,14 +435,13 @@ class TrainTrackCoupling:
         def value(vec: np.ndarray, k: int) -> np.ndarray:
             return vec.reshape(n, 8, COMPONENTS)[..., k]
 
-        cosg, sing = np.cos(angle), np.sin(angle)
-        d_delta = -part(rail_disp, 2) - part(dwm, 2)
+        # Wheelset lateral displacement: y = y* + Ey g (for the contact geometry).
+        y_star = q_star[:, self._wheelset_y]
+        d_yrel = self.ey[None] - part(rail_disp, 1)
+        d_delta0 = -part(rail_disp, 2) - part(dwm, 2)
         d_xi_x = (a1 * part(dwm, 0) + part(rail_vel, 0)) / speed
         d_xi_y = (a1 * part(dwm, 1) + part(rail_vel, 1)) / speed - part(dwm, 3)
-        d_xi_sp = a1 * part(dwm, 3) * cosg[..., None] / speed
         creep_x = -(eps * f11)[..., None] * d_xi_x
-        creep_y = -(eps * f22)[..., None] * d_xi_y - (eps * f23)[..., None] * d_xi_sp
-        creep_m = (eps * f23)[..., None] * d_xi_y - (eps * f33)[..., None] * d_xi_sp
         g = self.force.reshape(n, m).copy()
         total_iter = 0
         change = math.inf
@@ -455,7 +454,17 @@ class TrainTrackCoupling:
                 wv = wv0 + a1 * np.einsum('cij,cj->ci', dwm, g)
                 r = rp - np.einsum('cij,cj->ci', rail_disp, g)
                 rv = rvp - np.einsum('cij,cj->ci', rail_vel, g)
-                delta = value(r, 2) + irr_z - value(w, 2) + dr_rad
+                # Contact geometry at the end-of-step lateral position.
+                y_rel = y_star + np.einsum('wj,cj->cw', self.ey, g) - value(r, 1) - irr_y
+                radius, angle = self._geometry(y_rel)
+                radius_slope = (self._geometry(y_rel + GEOMETRY_STEP)[0]
+                                - self._geometry(y_rel - GEOMETRY_STEP)[0]) / (2 * GEOMETRY_STEP)
+                cosg, sing, tan_g = np.cos(angle), np.sin(angle), np.tan(angle)
+                d_delta = d_delta0 + radius_slope[..., None] * d_yrel
+                d_xi_sp = a1 * part(dwm, 3) * cosg[..., None] / speed
+                creep_y = -(eps * f22)[..., None] * d_xi_y - (eps * f23)[..., None] * d_xi_sp
+                creep_m = (eps * f23)[..., None] * d_xi_y - (eps * f33)[..., None] * d_xi_sp
+                delta = value(r, 2) + irr_z - value(w, 2) + radius - self.r0
                 fz = ct.normal_force(delta, self.g_hertz)
                 kh = ct.normal_force_derivative(delta, self.g_hertz)
                 xi_x = (value(wv, 0) - value(rv, 0)) / speed + 1.0 - radius / self.r0

@@ -1,0 +1,112 @@
+# Copyright 2026 The ttb_sim Authors
+#
+# Licensed under the Apache License, Version 2.0 (the "License");
+# you may not use this file except in compliance with the License.
+# You may obtain a copy of the License at
+#
+#     http://www.apache.org/licenses/LICENSE-2.0
+#
+# Unless required by applicable law or agreed to in writing, software
+# distributed under the License is distributed on an "AS IS" BASIS,
+# WITHOUT WARRANTIES OR CONDITIONS OF ANY KIND, either express or implied.
+# See the License for the specific language governing permissions and
+# limitations under the License.
+
+"""Multibody cars on the slab track: static start, mean forces, contact convergence."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from ttb_sim.errors import ScenarioError
+from ttb_sim.model import contact as ct
+from ttb_sim.scenario import load_scenario
+from ttb_sim.sim.simulation import Simulation
+from ttb_sim.sim.ttbi import car_parameters
+
+SMALL = [('train.vehicle', 'car'), ('track.model', 'slab'), ('train.n_cars', 1),
+         ('bridge.n_spans', 1), ('bearings.model', 'elastic'), ('train.start_position', 0.0)]
+
+
+def small_car(duration: float, extra: list | None = None) -> Simulation:
+    """One car running onto a one-span bridge."""
+    values = SMALL + [('solver.duration', duration)] + (extra or [])
+    return Simulation(load_scenario('moving_force_beam', values=values))
+
+
+@pytest.fixture(scope='module')
+def smooth_run() -> tuple[Simulation, list]:
+    sim = small_car(0.4)
+    return sim, list(sim.frames())
+
+
+def test_static_start_carries_the_static_wheel_load(smooth_run):
+    sim, frames = smooth_run
+    p0 = car_parameters(sim.scenario).static_wheel_load
+    first = frames[0].wheel_rail[0, :, :, 2]
+    np.testing.assert_allclose(first, p0, rtol=1e-4)
+    # No start-up transient: the car body hardly moves in the first 0.1 s.
+    acc = np.array([f.body_acceleration[0, 2] for f in frames[:1000]])
+    assert np.max(np.abs(acc)) < 0.01
+
+
+def test_mean_vertical_force_is_the_static_load_and_lateral_balances(smooth_run):
+    sim, frames = smooth_run
+    p0 = car_parameters(sim.scenario).static_wheel_load
+    wr = np.array([f.wheel_rail[0] for f in frames])           # (t, axle, side, xyz)
+    mean_z = wr[..., 2].mean(axis=0)
+    np.testing.assert_allclose(mean_z, p0, rtol=0.005)
+    # Left and right wheels of every wheelset: lateral forces equal and opposite
+    # (the tilted normal force spreads the rails), so each wheelset's sum is zero.
+    np.testing.assert_allclose(wr[..., 0, 1], -wr[..., 1, 1], atol=1e-6 * p0)
+    assert np.all(np.abs(wr[..., 1].mean(axis=0)) < 0.02 * p0)
+
+
+def test_contact_forces_satisfy_hertz_on_the_exact_track_response():
+    sim = small_car(0.02, [('irregularity.spectrum', 'paper'), ('irregularity.seed', 3)])
+    tt = sim.train_track
+    for _ in sim.frames():
+        pass
+    x = sim.scenario.train.start_position + sim.speed * sim.n_steps * sim.dt + tt.contact_x
+    rows, _, dofs, _ = tt._rail_rows(x)
+    ue = np.append(tt.u, 0.0)
+    rail_z = np.einsum('cwj,cwj->cw', rows[..., 2, :], ue[dofs])
+    irr_z, _, _ = tt._irregularity(x)
+    wheel_z = (tt.q @ tt.h.T).reshape(tt.n_cars, 8, 4)[..., 2]
+    y_rel = tt.q[:, tt._wheelset_y] - tt._rail_y - tt._irregularity(x)[1]
+    radius, _ = tt._geometry(y_rel)
+    delta = rail_z + irr_z - wheel_z + radius - tt.r0
+    hertz = ct.normal_force(delta, tt.g_hertz)
+    # The tolerance is on the compression; the force follows through k_H.
+    k_h = ct.linearised_stiffness(tt.p0, tt.g_hertz)
+    np.testing.assert_allclose(tt.force[..., 2], hertz, atol=5 * k_h * tt.tol + 1e-6)
+
+
+def test_girder_observer_matches_the_midspan_topic():
+    sim = small_car(0.05, [('output.observers', ['mid=girder@16.0', 'rail=rail_left@16.0'])])
+    frames = list(sim.frames())
+    mid = np.array([f.midspan[0] for f in frames])
+    obs = np.array([f.observers[0] for f in frames])
+    np.testing.assert_allclose(obs, mid, atol=1e-15)
+    assert sim.layout.observers == ('mid', 'rail')
+
+
+@pytest.mark.parametrize('entry, words', [
+    ('nameonly', "expected 'name=component@x'"),
+    ('a=deck@3', "component 'deck' is unknown"),
+    ('a=rail_left@abc', 'not a finite number'),
+])
+def test_bad_observers_are_rejected(entry, words):
+    with pytest.raises(ScenarioError, match=words):
+        load_scenario('moving_force_beam', values=[('output.observers', [entry])])
+
+
+def test_observer_off_the_track_is_rejected():
+    with pytest.raises(ScenarioError, match='output.observers.0. = far=rail_left@9999'):
+        small_car(0.01, [('output.observers', ['far=rail_left@9999'])])
+
+
+def test_cars_need_the_slab_track():
+    with pytest.raises(ScenarioError, match="needs track.model = 'slab'"):
+        load_scenario('moving_force_beam', values=[('train.vehicle', 'car')])
