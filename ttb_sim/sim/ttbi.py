@@ -35,11 +35,12 @@ contact angle from the profile table at the wheelset's lateral position
 relative to the rail) and Kalker's linear creep forces on the creepages, which
 are affine in the end-of-step velocities. A Newton iteration solves them; only
 the Shen-Hedrick-Elkins saturation factor and the load scaling of the creep
-coefficients are taken from the previous step (an explicit lag of O(dt)). After the Newton iteration the track is solved exactly with
-those forces and the rail displacement under every wheel is compared with the
-local prediction; any mismatch above ``contact.tolerance`` is fed back and the
-iteration repeated, so each step's contact forces satisfy the contact laws on
-the exact track response to that tolerance.
+coefficients are taken from the previous step (an explicit lag of O(dt)).
+After the Newton iteration the track is solved exactly with those forces and
+the rail displacement under every wheel is compared with the local prediction;
+any mismatch above ``contact.tolerance`` is fed back and the iteration
+repeated, so each step's contact forces satisfy the contact laws on the exact
+track response to that tolerance.
 """
 
 from __future__ import annotations
