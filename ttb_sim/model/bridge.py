@@ -37,9 +37,8 @@ import numpy as np
 import scipy.sparse as sp
 
 from ttb_sim.fe.assembly import assemble, assemble_links, link_kinematics
-from ttb_sim.fe.beam import (BeamSection, field_rows, global_matrices, NODE_DOFS,
-                             offset_rows, vertical_row, W_DOFS)
-from ttb_sim.model.track import build_track, TrackMesh
+from ttb_sim.fe.beam import BeamSection, global_matrices, NODE_DOFS, vertical_row, W_DOFS
+from ttb_sim.model.track import BeamLine, build_track, TrackMesh
 from ttb_sim.scenario import Scenario, TrainConfig
 
 
@@ -66,8 +65,6 @@ class GirderLine:
     """(n_elements, 4) extended free index of (uz1, ry1, uz2, ry2)."""
     w_dofs_full: np.ndarray
     """(n_elements, 4) full DOF index of the same."""
-    element_dofs: np.ndarray
-    """(n_elements, 12) full DOF index of all the element's DOFs."""
 
     @property
     def length(self) -> float:
@@ -184,6 +181,8 @@ class Structure:
     """First vertical bending frequency of a simply supported span (Hz)."""
     rayleigh: tuple[float, float]
     """Rayleigh coefficients (a0, a1) of C = a0 M + a1 K for the beams."""
+    girder_beam: BeamLine | None = None
+    """The girders as a beam line (full DOFs), for point lookups of all six fields."""
     track: TrackMesh | None = None
     """The slab track (full DOF numbering), if modelled."""
 
@@ -252,21 +251,12 @@ def build_structure(scenario: Scenario) -> Structure:
     n_bridge_el = sum(c.shape[0] for c in conn)
     girder_el = conn[0]
     girder_el_dofs = (girder_el[:, :, None] * NODE_DOFS + np.arange(NODE_DOFS)).reshape(-1, 12)
+    girder_beam = BeamLine(start=xg[girder_el[:, 0]], length=np.full(len(girder_el), span / ne),
+                           dofs=girder_el_dofs, z=0.0)
     track = None
     if scenario.track.model == 'slab':
-        line = GirderLine(span_length=span, n_spans=n_spans, elements_per_span=ne,
-                          w_dofs=girder_el_dofs[:, W_DOFS], w_dofs_full=girder_el_dofs[:, W_DOFS],
-                          element_dofs=girder_el_dofs)
-
-        def girder_rows(x: np.ndarray, arm: np.ndarray
-                        ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-            element, xi, on = line.locate(x)
-            f = field_rows(xi, line.element_length)
-            rows = np.concatenate([offset_rows(f, arm), f[:, 3:4, :]], axis=1)
-            return girder_el_dofs[element], rows * on[:, None, None], on
-
         track = build_track(scenario.track, span * n_spans, train_length(scenario.train),
-                            n_nodes, girder_rows)
+                            n_nodes, girder_beam)
         coords.append(track.coords)
         conn.append(track.elements)
         sections.append(track.sections)
@@ -369,15 +359,15 @@ def build_structure(scenario: Scenario) -> Structure:
     el_nodes = conn[0]
     wfull = el_nodes[:, [0, 0, 1, 1]] * NODE_DOFS + W_DOFS % NODE_DOFS
     girder = GirderLine(span_length=span, n_spans=n_spans, elements_per_span=ne,
-                        w_dofs=full_to_free[wfull], w_dofs_full=wfull,
-                        element_dofs=girder_el_dofs)
+                        w_dofs=full_to_free[wfull], w_dofs_full=wfull)
     mid = girder_nodes[:, ne // 2]
     midspan = full_to_free[mid[:, None] * NODE_DOFS + np.arange(3)]
     return Structure(mass=reduce(m_full), damping=reduce(c_full), stiffness=reduce(k_full),
                      n_full=n_full, free=free, full_to_free=full_to_free, girder=girder,
                      midspan_dofs=midspan, bearings=bearings, rigid=rigid,
                      n_supports=n_supports, bearing_spacing=br.spacing,
-                     fundamental_frequency=f1, rayleigh=(a0, a1), track=track)
+                     fundamental_frequency=f1, rayleigh=(a0, a1),
+                     girder_beam=girder_beam, track=track)
 
 
 def _uniform_section(n: int, ea: float, gj: float, ei_y: float, ei_z: float, mass: float,

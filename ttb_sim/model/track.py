@@ -37,10 +37,10 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 import math
-from typing import Callable
 
 import numpy as np
 
+from ttb_sim.fe.assembly import link_kinematics
 from ttb_sim.fe.beam import BeamSection, field_rows, NODE_DOFS, offset_rows, point_rows
 from ttb_sim.scenario import TrackConfig
 
@@ -48,9 +48,6 @@ POISSON_CONCRETE = 0.2
 STEEL_DENSITY = 7850.0
 GAUSS_POINTS = 3
 _GX, _GW = np.polynomial.legendre.leggauss(GAUSS_POINTS)
-
-GirderRows = Callable[[np.ndarray, np.ndarray], tuple[np.ndarray, np.ndarray, np.ndarray]]
-"""(x, arm) -> (full DOFs (n, 12), rows (n, 4, 12) of x, y, z, roll; on-girder mask)."""
 
 
 @dataclass(frozen=True)
@@ -112,6 +109,22 @@ class BeamLine:
         element, xi, inside = self.locate(x)
         r = point_rows(xi, self.length[element], arm, derivative)
         return element, r * inside[:, None, None], inside
+
+    def link_rows(self, x: np.ndarray, arm: np.ndarray
+                  ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """
+        Return what a spring link needs from points at ``arm`` from the beam axis.
+
+        Returns
+        -------
+        (full DOFs (n, 12), rows (n, 4, 12) of the x, y, z motion and the roll,
+        inside); rows are zero outside the beam.
+
+        """
+        element, xi, inside = self.locate(x)
+        f = field_rows(xi, self.length[element])
+        rows = np.concatenate([offset_rows(f, arm), f[:, 3:4, :]], axis=1)
+        return self.dofs[element], rows * inside[:, None, None], inside
 
 
 @dataclass(frozen=True)
@@ -185,7 +198,7 @@ def approach_length(track: TrackConfig, train_length: float) -> float:
 
 
 def build_track(track: TrackConfig, bridge_length: float, train_length: float,
-                first_node: int, girder_rows: GirderRows) -> TrackMesh:
+                first_node: int, girder: BeamLine) -> TrackMesh:
     """
     Build the track from x = -approach to bridge_length + approach.
 
@@ -199,8 +212,8 @@ def build_track(track: TrackConfig, bridge_length: float, train_length: float,
         Length of the train, for the automatic approach length (m).
     first_node : int
         Global number of the first track node.
-    girder_rows : callable
-        Point rows of the girder top (see :data:`GirderRows`).
+    girder : BeamLine
+        The girders' axis (full DOFs); the base plates rest on its top surface.
 
     Returns
     -------
@@ -311,11 +324,10 @@ def build_track(track: TrackConfig, bridge_length: float, train_length: float,
     # Continuous layers, integrated by Gauss quadrature over the upper beam's elements.
     k_l, c_l = track.layer_stiffness, track.layer_damping
     slab_base = _layer(slab, np.array([0.0, 0.0, -0.5 * track.slab_thickness]),
-                       _line_rows(base, np.array([0.0, 0.0, 0.5 * track.base_thickness])),
+                       base, np.array([0.0, 0.0, 0.5 * track.base_thickness]),
                        k_l, c_l, track.slab_width)
     base_girder = _layer(base, np.array([0.0, 0.0, -0.5 * track.base_thickness]),
-                         lambda x: girder_rows(x, np.array([0.0, 0.0, h_g])),
-                         k_l, c_l, track.base_width)
+                         girder, np.array([0.0, 0.0, h_g]), k_l, c_l, track.base_width)
     fasteners = LinkSet(np.concatenate(dofs_f), np.concatenate(kin_f), kf, cf)
     return TrackMesh(coords=coords_all, elements=elements, sections=section, rails=rails,
                      slab=slab, base=base, links=(fasteners, slab_base, base_girder),
@@ -329,40 +341,20 @@ def _node_dofs(nodes: np.ndarray) -> np.ndarray:
 
 def _node_link(arm_a: np.ndarray, arm_b: np.ndarray) -> np.ndarray:
     """Return (4, 12) rows of the relative motion and roll of two nodes' arm tips."""
-    return np.concatenate([_arm_rows(arm_a), -_arm_rows(arm_b)], axis=1)
+    roll = np.zeros((1, 12))
+    roll[0, 3], roll[0, 9] = 1.0, -1.0
+    return np.concatenate([link_kinematics(arm_a, arm_b)[0], roll])
 
 
-def _arm_rows(arm: np.ndarray) -> np.ndarray:
-    """Return (4, 6) rows of a node's arm tip motion (x, y, z) and its roll."""
-    f = np.zeros((1, 6, 12))
-    f[0, :, :6] = np.eye(6)
-    rows = np.zeros((4, 6))
-    rows[:3] = offset_rows(f, arm)[0, :, :6]
-    rows[3, 3] = 1.0
-    return rows
-
-
-def _line_rows(line: BeamLine, arm: np.ndarray
-               ) -> Callable[[np.ndarray], tuple[np.ndarray, np.ndarray, np.ndarray]]:
-    """Return x -> (full DOFs, rows (n, 4, 12), inside) for points of a beam line."""
-    def rows(x: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        element, xi, inside = line.locate(x)
-        f = field_rows(xi, line.length[element])
-        out = np.concatenate([offset_rows(f, arm), f[:, 3:4, :]], axis=1)
-        return line.dofs[element], out * inside[:, None, None], inside
-    return rows
-
-
-def _layer(upper: BeamLine, arm: np.ndarray,
-           lower: Callable[[np.ndarray], tuple[np.ndarray, np.ndarray, np.ndarray]],
+def _layer(upper: BeamLine, arm: np.ndarray, lower: BeamLine, lower_arm: np.ndarray,
            stiffness: float, damping: float, width: float) -> LinkSet:
     """
     Integrate a continuous spring-dashpot layer under every element of ``upper``.
 
     The layer resists relative x, y, z motion with ``stiffness`` per metre of
     track (x assumed equal to y) and relative roll with stiffness * width^2 / 12
-    (vertical springs spread over the width). Where ``lower`` reports no beam,
-    the layer rests on rigid ground.
+    (vertical springs spread over the width). Where ``lower`` has no element
+    (beyond its ends, in its gaps), the layer rests on rigid ground.
 
     Returns
     -------
@@ -375,10 +367,9 @@ def _layer(upper: BeamLine, arm: np.ndarray,
     element = np.repeat(np.arange(n_el), GAUSS_POINTS)
     weight = np.tile(0.5 * _GW, n_el) * upper.length[element]
     x = upper.start[element] + xi * upper.length[element]
-    f = field_rows(xi, upper.length[element])
-    rows_a = np.concatenate([offset_rows(f, arm), f[:, 3:4, :]], axis=1)
-    dofs_b, rows_b, on = lower(x)
-    dofs = np.concatenate([upper.dofs[element], np.where(on[:, None], dofs_b, -1)], axis=1)
+    dofs_a, rows_a, _ = upper.link_rows(x, arm)
+    dofs_b, rows_b, on = lower.link_rows(x, lower_arm)
+    dofs = np.concatenate([dofs_a, np.where(on[:, None], dofs_b, -1)], axis=1)
     kin = np.concatenate([rows_a, -rows_b], axis=2)
     per_length = np.array([1.0, 1.0, 1.0, width**2 / 12.0])
     return LinkSet(dofs, kin, weight[:, None] * stiffness * per_length,

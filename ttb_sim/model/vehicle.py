@@ -23,7 +23,7 @@ ground off it. Vehicle displacements are measured from static equilibrium, z up.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -103,7 +103,6 @@ def build_vehicle(train: TrainConfig) -> Vehicle:
     axles = Axles(offsets=np.asarray(train.axle_positions(), dtype=float))
     n = axles.count
     if train.vehicle == 'car':
-        from dataclasses import replace
         layout = replace(train, axle_offsets=()).axle_positions()
         return MultibodyCars(axles=Axles(offsets=np.asarray(layout, dtype=float)),
                              n_cars=train.n_cars, car_length=train.car_length)

@@ -28,7 +28,6 @@ from typing import Iterator
 import numpy as np
 
 from ttb_sim.errors import DivergenceError, ScenarioError
-from ttb_sim.fe.beam import point_rows
 from ttb_sim.model.bridge import bearing_forces, build_structure, Structure
 from ttb_sim.model.irregularity import load_csv, synthesize, TrackIrregularity
 from ttb_sim.model.vehicle import build_vehicle, MovingForces, MultibodyCars, QuarterCars
@@ -58,15 +57,17 @@ def nice_step(dt: float) -> float:
 
 def auto_time_step(fundamental_frequency: float, element_length: float, speed: float,
                    vehicle_frequency: float | None = None,
-                   profile_spacing: float | None = None) -> float:
+                   profile_spacing: float | None = None,
+                   max_step: float | None = None) -> float:
     """
     Pick the default time step.
 
     The rule: the smallest of T1/200 (T1 = first vertical bending period of a
     span), the time an axle takes to cross one tenth of a girder element,
     Tv/200 for a sprung vehicle (Tv = bounce period) and, on an irregular
-    track, the time to cross one grid cell of the profile; rounded down to 1, 2
-    or 5 x 10^k s. Newmark's period error at T/200 is 0.008 %.
+    track, the time to cross one grid cell of the profile, and ``max_step``
+    (wheel-rail contact); rounded down to 1, 2 or 5 x 10^k s. Newmark's period
+    error at T/200 is 0.008 %.
     """
     candidates = [1.0 / (STEPS_PER_PERIOD * fundamental_frequency),
                   element_length / (STEPS_PER_ELEMENT * speed)]
@@ -74,6 +75,8 @@ def auto_time_step(fundamental_frequency: float, element_length: float, speed: f
         candidates.append(1.0 / (STEPS_PER_PERIOD * vehicle_frequency))
     if profile_spacing:
         candidates.append(profile_spacing / speed)
+    if max_step:
+        candidates.append(max_step)
     return nice_step(min(candidates))
 
 
@@ -96,31 +99,24 @@ def observer_rows(scenario: Scenario, structure: Structure) -> tuple[np.ndarray,
     dofs = np.zeros((len(observers), 12), dtype=int)
     rows = np.zeros((len(observers), 3, 12))
     ftf = structure.full_to_free
+    track = structure.track
     for i, obs in enumerate(observers):
         where = f'output.observers[{i}] = {obs.name}={obs.component}@{obs.x:g}'
-        x = np.array([obs.x])
         if obs.component == 'girder':
-            girder = structure.girder
-            element, xi, on = girder.locate(x)
-            if not on[0]:
-                raise ScenarioError(f'{where}: x is off the bridge; allowed: 0..'
-                                    f'{girder.length:g} m')
-            full = girder.element_dofs[element[0]]
-            r = point_rows(xi, girder.element_length, np.zeros(3))[0]
+            line = structure.girder_beam
+        elif track is None:
+            raise ScenarioError(f'{where}: component {obs.component!r} needs '
+                                "track.model = 'slab'")
         else:
-            track = structure.track
-            if track is None:
-                raise ScenarioError(f'{where}: component {obs.component!r} needs '
-                                    "track.model = 'slab'")
             line = {'rail_left': track.rails[0], 'rail_right': track.rails[1],
                     'slab': track.slab, 'base': track.base}[obs.component]
-            element, r3, inside = line.rows(x, np.zeros(3))
-            if not inside[0]:
-                raise ScenarioError(f'{where}: x is not on the {obs.component} (the track '
-                                    f'runs from {track.x_start:g} to {track.x_end:g} m; slab '
-                                    'and base units have gaps)')
-            full = line.dofs[element[0]]
-            r = r3[0]
+        element, r3, inside = line.rows(np.array([obs.x]), np.zeros(3))
+        if not inside[0]:
+            raise ScenarioError(f'{where}: x is not on the {obs.component}, which runs from '
+                                f'{line.start[0]:g} to {line.end:g} m (slab and base units '
+                                'have gaps)')
+        full = line.dofs[element[0]]
+        r = r3[0]
         dofs[i] = ftf[full]
         rows[i] = r
     return dofs, rows
@@ -187,20 +183,21 @@ class Simulation:
         vf = None
         self.irregularity: TrackIrregularity | None = None
         element = st.girder.element_length
+        max_step = None
         if isinstance(self.vehicle, QuarterCars):
             vf = float(self.vehicle.natural_frequency().max())
             self.irregularity = build_irregularity(scenario, self.vehicle.axles.train_length,
                                                    st.girder.length)
         elif isinstance(self.vehicle, MultibodyCars):
             track = st.track
-            vf = 1.0 / (STEPS_PER_PERIOD * CONTACT_STEP)
+            max_step = CONTACT_STEP
             element = float(track.rails[0].length.min())
             self.irregularity = build_irregularity(scenario, self.vehicle.length,
                                                    st.girder.length,
                                                    (track.x_start, track.x_end))
         spacing = self.irregularity.dx if self.irregularity is not None else None
         dt = scenario.solver.dt or auto_time_step(st.fundamental_frequency, element,
-                                                  self.speed, vf, spacing)
+                                                  self.speed, vf, spacing, max_step)
         rate = scenario.output.rate_hz
         if rate > 0:
             period = 1.0 / rate
@@ -267,7 +264,6 @@ class Simulation:
         st, nm = self.structure, self.integrator
         n_free, dt = st.n_free, self.dt
         offsets = self.vehicle.axles.offsets
-        limit = self.scenario.solver.divergence_limit
         u = np.zeros(n_free)
         v = np.zeros(n_free)
         head = self.scenario.train.start_position
@@ -284,34 +280,32 @@ class Simulation:
             else:
                 u, v, a = self.coupling.step(u, v, a, zero, positions, self.speed,
                                              self._profile(positions))
-            peak = float(np.max(np.abs(u))) if n_free else 0.0
-            if not math.isfinite(peak) or peak > limit or (
-                    self.coupling is not None and not np.all(np.isfinite(self.coupling.z))):
-                raise DivergenceError(
-                    f'solution diverged at t = {step * dt:.6g} s (step {step}): largest '
-                    f'displacement {peak:.3g} m exceeds solver.divergence_limit = {limit:g} m '
-                    'or is not finite; try a smaller solver.dt')
+            self._check_state(step, u, *(() if self.coupling is None else (self.coupling.z,)))
             if step % self.output_every == 0:
                 if self.coupling is not None:
                     load_full = self._wheel_load(positions, self.coupling.contact)
                 yield self._frame(step, head, u, v, a, load_full)
 
+    def _check_state(self, step: int, *displacements: np.ndarray) -> None:
+        """Raise DivergenceError if any displacement is not finite or exceeds the limit."""
+        limit = self.scenario.solver.divergence_limit
+        peak = max((float(np.max(np.abs(d))) for d in displacements if d.size), default=0.0)
+        if not math.isfinite(peak) or peak > limit:
+            raise DivergenceError(
+                f'solution diverged at t = {step * self.dt:.6g} s (step {step}): largest '
+                f'displacement {peak:.3g} m exceeds solver.divergence_limit = {limit:g} m '
+                'or is not finite; try a smaller solver.dt')
+
     def _car_frames(self) -> Iterator[Frame]:
         """Step multibody cars on the slab track (see :mod:`ttb_sim.sim.ttbi`)."""
         tt, dt = self.train_track, self.dt
-        limit = self.scenario.solver.divergence_limit
         head = self.scenario.train.start_position
         tt.equilibrium(head)
         yield self._car_frame(0, head)
         for step in range(1, self.n_steps + 1):
             head += self.speed * dt
             tt.step(head, self.speed)
-            peak = max(float(np.max(np.abs(tt.u))), float(np.max(np.abs(tt.q))))
-            if not math.isfinite(peak) or peak > limit:
-                raise DivergenceError(
-                    f'solution diverged at t = {step * dt:.6g} s (step {step}): largest '
-                    f'displacement {peak:.3g} m exceeds solver.divergence_limit = {limit:g} m '
-                    'or is not finite; try a smaller solver.dt')
+            self._check_state(step, tt.u, tt.q)
             if step % self.output_every == 0:
                 yield self._car_frame(step, head)
 

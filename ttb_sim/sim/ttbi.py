@@ -183,7 +183,6 @@ class TrainTrackCoupling:
         p = self.params
         tm = train_matrices(p, scenario.train.n_cars, scenario.train.car_length)
         self.n_cars = tm.n_cars
-        self.train = tm
         n = self.n_cars
         self.mass = tm.mass[:42, :42].toarray()
         self.damping = tm.damping[:42, :42].toarray()
@@ -209,7 +208,6 @@ class TrainTrackCoupling:
         else:
             self.table = None
         track = structure.track
-        self.track = track
         self.rails = track.rails
         self.head_arm = np.array([0.0, 0.0, track.rail_head])
         ftf = structure.full_to_free
