@@ -225,6 +225,13 @@ class CarConfig:
                                             'per bogie).', low=0, high=64)
     secondary_lateral_dampers: int = param(2, '-', 'Secondary lateral dampers per car (one '
                                            'per bogie).', low=0, high=64)
+    yaw_damping: float = param(250.0e3, 'N*s/m', 'Anti-yaw (longitudinal) damper between '
+                               'bogie and car body, per damper; assumed, not in [P] Table 1 '
+                               '(see README).', low=0.0, high=1e9)
+    yaw_dampers: int = param(4, '-', 'Anti-yaw dampers per car (one on each side of each bogie; '
+                             '0 = the literal Table 1 car).', low=0, high=64)
+    yaw_damper_semi_spacing: float = param(1.35, 'm', 'Lateral semi-spacing of the anti-yaw '
+                                           'dampers (assumed).', low=0.1, high=2.0)
     wheel_radius: float = param(0.46, 'm', 'Nominal rolling radius r0.', low=0.1, high=2.0)
     contact_semi_distance: float = param(0.7465, 'm', 'Half the lateral distance between '
                                          'the contact points b.', low=0.3, high=1.5)

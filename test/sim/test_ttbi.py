@@ -75,8 +75,8 @@ def test_contact_forces_satisfy_hertz_on_the_exact_track_response():
     irr_z, _, _ = tt._irregularity(x)
     wheel_z = (tt.q @ tt.h.T).reshape(tt.n_cars, 8, 4)[..., 2]
     y_rel = tt.q[:, tt._wheelset_y] - tt._rail_y - tt._irregularity(x)[1]
-    radius, _ = tt._geometry(y_rel)
-    delta = rail_z + irr_z - wheel_z + radius - tt.r0
+    _, _, height = tt._geometry(y_rel)
+    delta = rail_z + irr_z - wheel_z + height
     hertz = ct.normal_force(delta, tt.g_hertz)
     # The tolerance is on the compression; the force follows through k_H.
     k_h = ct.linearised_stiffness(tt.p0, tt.g_hertz)

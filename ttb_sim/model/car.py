@@ -230,6 +230,14 @@ class CarParameters:
         evenly over the 8 axle boxes / 4 air springs.
     n_secondary_lateral_dampers : int
         Secondary lateral dampers per car (default 4).
+    yaw_damping : float
+        Longitudinal (anti-yaw) damper coefficient between bogie frame and car
+        body, per damper (N s/m; assumed 250e3, not in [P] Table 1).
+    n_yaw_dampers : int
+        Anti-yaw dampers per car (default 4: one on each side of each bogie,
+        smeared over the 4 positions); 0 gives the literal Table 1 car.
+    yaw_damper_semi_spacing : float
+        Lateral semi-spacing of the anti-yaw dampers (assumed 1.35 m).
     bogie_semi_distance, axle_semi_distance : float
         l_c = 7.85 m and l_t = 1.25 m.
     wheel_radius : float
@@ -268,9 +276,12 @@ class CarParameters:
     primary_damping_z: float = 45.0e3
     secondary_damping_y: float = 3.0e3
     secondary_damping_z: float = 98.0e3
+    yaw_damping: float = 250.0e3
     n_primary_vertical_dampers: int = 8
     n_secondary_vertical_dampers: int = 4
     n_secondary_lateral_dampers: int = 4
+    n_yaw_dampers: int = 4
+    yaw_damper_semi_spacing: float = 1.35
     bogie_semi_distance: float = 7.85
     axle_semi_distance: float = 1.25
     wheel_radius: float = 0.46
@@ -283,9 +294,12 @@ class CarParameters:
     longitudinal_pitch_coupling: bool = False
 
     def __post_init__(self) -> None:
-        positive = {f.name for f in fields(self)} - {
-            'n_primary_vertical_dampers', 'n_secondary_vertical_dampers',
-            'n_secondary_lateral_dampers', 'longitudinal_pitch_coupling'}
+        counts = ('n_primary_vertical_dampers', 'n_secondary_vertical_dampers',
+                  'n_secondary_lateral_dampers', 'n_yaw_dampers')
+        dampers = ('primary_damping_z', 'secondary_damping_y', 'secondary_damping_z',
+                   'yaw_damping')
+        flags = ('longitudinal_pitch_coupling',)
+        positive = {f.name for f in fields(self)} - {*counts, *dampers, *flags}
         if not isinstance(self.longitudinal_pitch_coupling, bool):
             msg = ('car parameter longitudinal_pitch_coupling = '
                    f'{self.longitudinal_pitch_coupling!r} is invalid; allowed: true or false')
@@ -295,8 +309,12 @@ class CarParameters:
             if not (isinstance(value, (int, float)) and math.isfinite(value) and value > 0.0):
                 msg = f'car parameter {name} = {value!r} is invalid; allowed: finite and > 0'
                 raise ScenarioError(msg)
-        for name in ('n_primary_vertical_dampers', 'n_secondary_vertical_dampers',
-                     'n_secondary_lateral_dampers'):
+        for name in dampers:
+            value = getattr(self, name)
+            if not (isinstance(value, (int, float)) and math.isfinite(value) and value >= 0.0):
+                msg = f'car parameter {name} = {value!r} is invalid; allowed: finite and >= 0'
+                raise ScenarioError(msg)
+        for name in counts:
             value = getattr(self, name)
             if isinstance(value, bool) or not isinstance(value, int) or not 0 <= value <= 64:
                 msg = f'car parameter {name} = {value!r} is invalid; allowed: integer 0..64'
@@ -423,7 +441,7 @@ class SuspensionElements:
 
 def suspension_elements(params: CarParameters | None = None) -> SuspensionElements:
     """
-    Return the 8 primary and 4 secondary suspension elements of a car.
+    Return the primary, secondary and anti-yaw suspension elements of a car.
 
     Parameters
     ----------
@@ -435,7 +453,9 @@ def suspension_elements(params: CarParameters | None = None) -> SuspensionElemen
     SuspensionElements
         Primary elements connect bogie i to its wheelsets at the axle boxes
         (on the axle axis, so wheelset spin is not restrained); secondary
-        elements connect the car body to each bogie at the air springs.
+        elements connect the car body to each bogie at the air springs;
+        anti-yaw elements (dampers only, longitudinal) connect the car body to
+        each bogie at +/- ``yaw_damper_semi_spacing``, omitted when there are none.
 
     """
     p = params or CarParameters()
@@ -445,7 +465,15 @@ def suspension_elements(params: CarParameters | None = None) -> SuspensionElemen
     c_pz = p.primary_damping_z * p.n_primary_vertical_dampers / 8.0
     c_sz = p.secondary_damping_z * p.n_secondary_vertical_dampers / 4.0
     c_sy = p.secondary_damping_y * p.n_secondary_lateral_dampers / 4.0
+    c_yaw = p.yaw_damping * p.n_yaw_dampers / 4.0
     for i, bogie in enumerate(BOGIES):
+        for side in SIDES if c_yaw > 0.0 else ():
+            body_a.append(CAR_BODY)
+            body_b.append(bogie)
+            point.append((pos[bogie, 0], side * p.yaw_damper_semi_spacing, p.secondary_height))
+            stiff.append((0.0, 0.0, 0.0))
+            damp.append((c_yaw, 0.0, 0.0))
+            group.append('yaw_damper')
         for side in SIDES:
             body_a.append(CAR_BODY)
             body_b.append(bogie)

@@ -505,6 +505,37 @@ class ContactGeometryTable:
         return WheelsetGeometry(rolling_radius=self._interp(y, self.rolling_radius),
                                 contact_angle=self._interp(y, self.contact_angle))
 
+    def wheel_height(self, y: ArrayLike, arm: float) -> np.ndarray:
+        """
+        Return the rigid-contact height of each wheel at lateral arm +/- ``arm`` (m).
+
+        This is ``rise + s arm roll`` (s = +1 left, -1 right): the vertical
+        position, relative to the centred wheelset, that a point of the wheelset
+        at lateral offset ``s arm`` takes when both wheels touch rigid rails.
+        A wheel's normal compression is this height minus the actual height of
+        the same point (plus rail motion).  Unlike the rolling radius, it is
+        continuous when the contact jumps from the tread to the flange, because
+        the minimum gap it comes from is continuous in y.
+
+        Parameters
+        ----------
+        y : array_like
+            Wheelset lateral displacement (m); clamped to the table range.
+        arm : float
+            Lateral semi-distance at which the wheel heights are measured (m),
+            the one the vehicle model uses for its contact points.
+
+        Returns
+        -------
+        numpy.ndarray
+            Shape ``y.shape + (2,)``: left, right (m, up).
+
+        """
+        y = np.asarray(y, dtype=float)
+        rise = np.interp(y, self.lateral, self.rise)[..., None]
+        roll = np.interp(y, self.lateral, self.roll)[..., None]
+        return rise + np.array([1.0, -1.0]) * arm * roll
+
     def radius_difference(self, y: ArrayLike) -> np.ndarray:
         """
         Return the rolling-radius difference r_L - r_R at y (m).

@@ -30,10 +30,12 @@ rail on the wheel, track axes):
   one step.
 
 The contact laws close the system, all at the end of the step: Hertz's normal
-force on the vertical compression, the contact geometry (rolling radius and
-contact angle from the profile table at the wheelset's lateral position
-relative to the rail) and Kalker's linear creep forces on the creepages, which
-are affine in the end-of-step velocities. A Newton iteration solves them; only
+force on the vertical compression, the contact geometry (rolling radius,
+contact angle and rigid-contact wheel height from the profile table at the
+wheelset's lateral position relative to the rail; the compression is measured
+from that height, which stays continuous when the contact jumps to the flange)
+and Kalker's linear creep forces on the creepages, which are affine in the
+end-of-step velocities. A Newton iteration solves them; only
 the Shen-Hedrick-Elkins saturation factor and the load scaling of the creep
 coefficients are taken from the previous step (an explicit lag of O(dt)).
 After the Newton iteration the track is solved exactly with those forces and
@@ -69,7 +71,7 @@ PROBE_SPACING = 24
 """Rail nodes between simultaneous probes of the local track compliance."""
 COMPONENTS = 4
 GEOMETRY_STEP = 1e-6
-"""Lateral step (m) of the central difference of the rolling radius."""
+"""Lateral step (m) of the central difference of the rigid-contact wheel height."""
 """Contact force components per wheel: Fx, Fy, Fz (on the wheel), Mz (spin moment)."""
 
 
@@ -91,7 +93,8 @@ def car_parameters(scenario: Scenario) -> CarParameters:
         secondary_stiffness_y=c.secondary_stiffness_y,
         secondary_stiffness_z=c.secondary_stiffness_z,
         primary_damping_z=c.primary_damping_z, secondary_damping_y=c.secondary_damping_y,
-        secondary_damping_z=c.secondary_damping_z,
+        secondary_damping_z=c.secondary_damping_z, yaw_damping=c.yaw_damping,
+        n_yaw_dampers=c.yaw_dampers, yaw_damper_semi_spacing=c.yaw_damper_semi_spacing,
         n_primary_vertical_dampers=c.primary_vertical_dampers,
         n_secondary_vertical_dampers=c.secondary_vertical_dampers,
         n_secondary_lateral_dampers=c.secondary_lateral_dampers,
@@ -267,16 +270,25 @@ class TrainTrackCoupling:
         dy = np.where(left, s.slope[2], s.slope[3])
         return z, y, dy
 
-    def _geometry(self, lateral: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """Return rolling radius and contact angle of each wheel at relative shifts."""
+    def _geometry(self, lateral: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """
+        Return rolling radius, contact angle and rigid-contact height of each wheel.
+
+        The height (m, up) is where the wheel's contact point would sit on rigid
+        rails at this relative shift (:meth:`ContactGeometryTable.wheel_height`);
+        with the conicity model it is r - r0 (knife-edge rails).
+        """
         if self.table is not None:
             g = self.table.wheelset_geometry(lateral)
+            h = self.table.wheel_height(lateral, self.params.contact_semi_distance)
         else:
             g = ct.simplified_geometry(lateral, self.scenario.contact.conicity, self.r0)
+            h = g.rolling_radius - self.r0
         left = self.side > 0
         radius = np.where(left, g.rolling_radius[..., 0], g.rolling_radius[..., 1])
         angle = np.where(left, g.contact_angle[..., 0], g.contact_angle[..., 1])
-        return radius, angle
+        height = np.where(left, h[..., 0], h[..., 1])
+        return radius, angle, height
 
     # -- train matrices -----------------------------------------------------------------
     def _update_speed(self, speed: float) -> None:
@@ -455,15 +467,15 @@ class TrainTrackCoupling:
                 rv = rvp - np.einsum('cij,cj->ci', rail_vel, g)
                 # Contact geometry at the end-of-step lateral position.
                 y_rel = y_star + np.einsum('wj,cj->cw', self.ey, g) - value(r, 1) - irr_y
-                radius, angle = self._geometry(y_rel)
-                radius_slope = (self._geometry(y_rel + GEOMETRY_STEP)[0]
-                                - self._geometry(y_rel - GEOMETRY_STEP)[0]) / (2 * GEOMETRY_STEP)
+                radius, angle, height = self._geometry(y_rel)
+                height_slope = (self._geometry(y_rel + GEOMETRY_STEP)[2]
+                                - self._geometry(y_rel - GEOMETRY_STEP)[2]) / (2 * GEOMETRY_STEP)
                 cosg, sing, tan_g = np.cos(angle), np.sin(angle), np.tan(angle)
-                d_delta = d_delta0 + radius_slope[..., None] * d_yrel
+                d_delta = d_delta0 + height_slope[..., None] * d_yrel
                 d_xi_sp = a1 * part(dwm, 3) * cosg[..., None] / speed
                 creep_y = -(eps * f22)[..., None] * d_xi_y - (eps * f23)[..., None] * d_xi_sp
                 creep_m = (eps * f23)[..., None] * d_xi_y - (eps * f33)[..., None] * d_xi_sp
-                delta = value(r, 2) + irr_z - value(w, 2) + radius - self.r0
+                delta = value(r, 2) + irr_z - value(w, 2) + height
                 fz = ct.normal_force(delta, self.g_hertz)
                 kh = ct.normal_force_derivative(delta, self.g_hertz)
                 xi_x = (value(wv, 0) - value(rv, 0)) / speed + 1.0 - radius / self.r0
