@@ -657,6 +657,30 @@ def she_ratio(beta: ArrayLike) -> np.ndarray:
     return np.where(x <= 3.0, x - x * x / 3.0 + x ** 3 / 27.0, 1.0)
 
 
+def she_factor_derivative(beta: ArrayLike) -> np.ndarray:
+    """
+    Return d epsilon / d beta of the Shen-Hedrick-Elkins reduction factor.
+
+    epsilon = she_ratio(beta) / beta = 1 - beta/3 + beta^2/27 for beta <= 3 and
+    1/beta beyond, so the derivative is -1/3 + 2 beta/27, resp. -1/beta^2
+    (continuous at beta = 3, where both are -1/9).  Used for the Jacobian of
+    the saturated creep forces.
+
+    Parameters
+    ----------
+    beta : array_like
+        Non-negative normalised linear creep force.
+
+    Returns
+    -------
+    numpy.ndarray
+        The derivative (-), between -1/3 and 0.
+
+    """
+    x = np.maximum(np.asarray(beta, dtype=float), 0.0)
+    return np.where(x <= 3.0, -1.0 / 3.0 + 2.0 * x / 27.0, -1.0 / np.maximum(x, 3.0) ** 2)
+
+
 def she_saturation(fx: ArrayLike, fy: ArrayLike, mz: ArrayLike, normal: ArrayLike,
                    friction: float = FRICTION_COEFFICIENT) -> tuple[np.ndarray, np.ndarray,
                                                                     np.ndarray, np.ndarray]:

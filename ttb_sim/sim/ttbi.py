@@ -35,9 +35,10 @@ contact angle and rigid-contact wheel height from the profile table at the
 wheelset's lateral position relative to the rail; the compression is measured
 from that height, which stays continuous when the contact jumps to the flange)
 and Kalker's linear creep forces on the creepages, which are affine in the
-end-of-step velocities. A Newton iteration solves them; only
-the Shen-Hedrick-Elkins saturation factor and the load scaling of the creep
-coefficients are taken from the previous step (an explicit lag of O(dt)).
+end-of-step velocities, saturated by the Shen-Hedrick-Elkins law. A Newton
+iteration solves them (with the derivatives of the geometry and of the
+saturation); only the load scaling of the creep coefficients is taken from the
+previous step (an explicit lag of O(dt)).
 After the Newton iteration the track is solved exactly with those forces and
 the rail displacement under every wheel is compared with the local prediction;
 any mismatch above ``contact.tolerance`` is fed back and the iteration
@@ -384,6 +385,42 @@ class TrainTrackCoupling:
         log.info('static equilibrium: wheel loads %.1f .. %.1f kN', load.min() / 1e3,
                  load.max() / 1e3)
 
+    def _saturation_slope(self, lin_x: np.ndarray, lin_y: np.ndarray, normal: np.ndarray,
+                          d_lin_x: np.ndarray, d_lin_y: np.ndarray,
+                          d_normal: np.ndarray) -> np.ndarray:
+        """
+        Return the derivative of the Shen-Hedrick-Elkins factor along the unknowns.
+
+        beta = |(Fx, Fy)_linear| / (mu N); d eps = eps'(beta) d beta with
+        d beta = (F . dF) / (|F| mu N) - beta dN / N.  Zero without contact.
+        """
+        f = np.hypot(lin_x, lin_y)
+        limit = self.friction * normal
+        active = (limit > 0.0) & (f > 0.0)
+        f_safe = np.where(active, f, 1.0)
+        limit_safe = np.where(active, limit, 1.0)
+        beta = f / limit_safe
+        d_beta = ((lin_x[..., None] * d_lin_x + lin_y[..., None] * d_lin_y)
+                  / (f_safe * limit_safe)[..., None]
+                  - (beta / np.where(active, normal, 1.0))[..., None] * d_normal)
+        slope = np.where(active, ct.she_factor_derivative(beta), 0.0)
+        return slope[..., None] * d_beta
+
+    def _check_flange(self, lateral: np.ndarray) -> None:
+        """Raise DivergenceError when a wheelset runs beyond the contact-geometry table."""
+        if self.table is None:
+            return
+        limit = float(self.table.lateral[-1])
+        beyond = np.abs(lateral) > limit
+        if np.any(beyond):
+            car, wheel = np.argwhere(beyond)[0]
+            shift = lateral[car, wheel] * 1e3
+            raise DivergenceError(
+                f'wheelset {wheel // 2 + 1} of car {car + 1} shifted {shift:.1f} mm relative '
+                f'to the rail, beyond the {limit * 1e3:.0f} mm of the contact-geometry '
+                'table: the flange is climbing the rail (derailment). Usually the '
+                'car hunts at this speed; check car.yaw_dampers and car.yaw_damping')
+
     # -- one step -------------------------------------------------------------------------
     def step(self, head: float, speed: float) -> None:
         """Advance train, track and bridge together to the head position ``head``."""
@@ -414,10 +451,9 @@ class TrainTrackCoupling:
         dr = np.einsum('cwij,cwjk,cwlk->cwil', rows, blocks, rows)
         ds = np.einsum('cwij,cwjk,cwlk->cwil', slope, blocks, rows)
 
-        # Creep coefficients (load scaling) and saturation from the previous step.
+        # Creep coefficients scaled with the previous step's normal load.
         normal = np.maximum(self.force[..., 2], 0.0)
         f11, f22, f23, f33 = ct.scale_creep_coefficients(self.creep0, self.p0, normal)
-        eps = self.saturation
         side = self.side
 
         # Affine maps of the end-of-step quantities in g (per car, 32 unknowns).
@@ -448,11 +484,10 @@ class TrainTrackCoupling:
 
         # Wheelset lateral displacement: y = y* + Ey g (for the contact geometry).
         y_star = q_star[:, self._wheelset_y]
-        d_yrel = self.ey[None] - part(rail_disp, 1)
+        d_yrel = self.ey[None] + part(rail_disp, 1)
         d_delta0 = -part(rail_disp, 2) - part(dwm, 2)
         d_xi_x = (a1 * part(dwm, 0) + part(rail_vel, 0)) / speed
         d_xi_y = (a1 * part(dwm, 1) + part(rail_vel, 1)) / speed - part(dwm, 3)
-        creep_x = -(eps * f11)[..., None] * d_xi_x
         g = self.force.reshape(n, m).copy()
         total_iter = 0
         change = math.inf
@@ -468,25 +503,38 @@ class TrainTrackCoupling:
                 # Contact geometry at the end-of-step lateral position.
                 y_rel = y_star + np.einsum('wj,cj->cw', self.ey, g) - value(r, 1) - irr_y
                 radius, angle, height = self._geometry(y_rel)
-                height_slope = (self._geometry(y_rel + GEOMETRY_STEP)[2]
-                                - self._geometry(y_rel - GEOMETRY_STEP)[2]) / (2 * GEOMETRY_STEP)
+                _, angle_hi, height_hi = self._geometry(y_rel + GEOMETRY_STEP)
+                _, angle_lo, height_lo = self._geometry(y_rel - GEOMETRY_STEP)
+                height_slope = (height_hi - height_lo) / (2 * GEOMETRY_STEP)
+                tan_slope = (np.tan(angle_hi) - np.tan(angle_lo)) / (2 * GEOMETRY_STEP)
                 cosg, sing, tan_g = np.cos(angle), np.sin(angle), np.tan(angle)
                 d_delta = d_delta0 + height_slope[..., None] * d_yrel
                 d_xi_sp = a1 * part(dwm, 3) * cosg[..., None] / speed
-                creep_y = -(eps * f22)[..., None] * d_xi_y - (eps * f23)[..., None] * d_xi_sp
-                creep_m = (eps * f23)[..., None] * d_xi_y - (eps * f33)[..., None] * d_xi_sp
                 delta = value(r, 2) + irr_z - value(w, 2) + height
                 fz = ct.normal_force(delta, self.g_hertz)
                 kh = ct.normal_force_derivative(delta, self.g_hertz)
                 xi_x = (value(wv, 0) - value(rv, 0)) / speed + 1.0 - radius / self.r0
                 xi_y = (value(wv, 1) - value(rv, 1) - speed * irr_dy) / speed - value(w, 3)
                 xi_sp = value(wv, 3) * cosg / speed - side * sing / self.r0
-                fx = -eps * f11 * xi_x
-                fy = -eps * (f22 * xi_y + f23 * xi_sp) - side * tan_g * fz
-                mz = eps * (f23 * xi_y - f33 * xi_sp)
+                # Kalker's linear creep forces, saturated (Shen-Hedrick-Elkins) at this
+                # iterate; the Jacobian includes the derivative of the factor.
+                lin_x = -f11 * xi_x
+                lin_y = -(f22 * xi_y + f23 * xi_sp)
+                lin_m = f23 * xi_y - f33 * xi_sp
+                fx, fy, mz, eps = ct.she_saturation(lin_x, lin_y, lin_m, fz, self.friction)
+                d_lin_x = -f11[..., None] * d_xi_x
+                d_lin_y = -f22[..., None] * d_xi_y - f23[..., None] * d_xi_sp
+                d_lin_m = f23[..., None] * d_xi_y - f33[..., None] * d_xi_sp
+                d_eps = self._saturation_slope(lin_x, lin_y, fz, d_lin_x, d_lin_y,
+                                               kh[..., None] * d_delta)
+                creep_x = eps[..., None] * d_lin_x + lin_x[..., None] * d_eps
+                creep_y = eps[..., None] * d_lin_y + lin_y[..., None] * d_eps
+                creep_m = eps[..., None] * d_lin_m + lin_m[..., None] * d_eps
+                fy = fy - side * tan_g * fz
                 target = np.stack([fx, fy, fz, mz], axis=-1).reshape(n, m)
                 jac_f = np.stack([creep_x,
-                                  creep_y - (side * tan_g * kh)[..., None] * d_delta,
+                                  creep_y - (side * tan_g * kh)[..., None] * d_delta
+                                  - (side * tan_slope * fz)[..., None] * d_yrel,
                                   kh[..., None] * d_delta, creep_m], axis=2).reshape(n, m, m)
                 dg = np.linalg.solve(eye - jac_f, (target - g)[..., None])[..., 0]
                 g = g + dg
@@ -513,6 +561,7 @@ class TrainTrackCoupling:
             raise DivergenceError('rail displacement under the wheels did not converge to '
                                   f'contact.tolerance = {self.tol:g} m')
 
+        self._check_flange(y_rel)
         # Accept the step.
         g3 = g.reshape(n, 8, COMPONENTS)
         q_new = q_star + (g @ self.h) @ self.a_inv.T
@@ -524,10 +573,5 @@ class TrainTrackCoupling:
         self.force = g3
         self.compression = delta
         self._rail_y = r_exact[..., 1]
-        lin = np.hypot(-f11 * xi_x, -(f22 * xi_y + f23 * xi_sp))
-        limit = self.friction * np.maximum(fz, 1e-9)
-        beta = lin / limit
-        with np.errstate(divide='ignore', invalid='ignore'):
-            self.saturation = np.where(beta > 1e-12, ct.she_ratio(beta) / beta, 1.0)
-        self.saturation = np.where(fz > 0.0, self.saturation, 0.0)
+        self.saturation = eps
         self.iterations = total_iter
