@@ -209,6 +209,18 @@ def test_she_saturation_properties():
     assert small[0] == pytest.approx(1.0, rel=1e-4) and small[1] == pytest.approx(2.0, rel=1e-4)
 
 
+def test_she_factor_derivative_matches_finite_differences():
+    """The derivative of epsilon = she_ratio(beta) / beta matches central differences (1e-7)."""
+    beta = np.array([1e-3, 0.5, 1.0, 2.0, 2.9, 3.1, 5.0, 20.0])
+    h = 1e-6 * beta
+    fd = (contact.she_ratio(beta + h) / (beta + h)
+          - contact.she_ratio(beta - h) / (beta - h)) / (2 * h)
+    np.testing.assert_allclose(contact.she_factor_derivative(beta), fd, rtol=1e-7, atol=1e-9)
+    # Continuous at beta = 3 (both branches give -1/9).
+    assert contact.she_factor_derivative(3.0) == pytest.approx(-1.0 / 9.0, rel=1e-15)
+    assert contact.she_factor_derivative(3.0 + 1e-12) == pytest.approx(-1.0 / 9.0, rel=1e-9)
+
+
 def test_she_saturation_no_contact_and_zero_force():
     """N <= 0 gives zero tangential forces; F = 0 with contact gives epsilon = 1."""
     out = contact.she_saturation([1e4, 0.0], [0.0, 0.0], [10.0, 0.0], [0.0, 5e4])
