@@ -364,9 +364,15 @@ class TrainTrackCoupling:
                 jac[rows_c, s] = kh[8 * c:8 * c + 8, None] * hz
             jac[n * n_sub:, n * n_sub:] = np.eye(m) + kh[:, None] * flex
             step = np.linalg.solve(jac, -np.concatenate([r1.ravel(), r2]))
-            q += step[:n * n_sub].reshape(n, n_sub)
-            load += step[n * n_sub:]
-            if np.max(np.abs(step[n * n_sub:])) < 1e-6 * self.p0:
+            dq = step[:n * n_sub].reshape(n, n_sub)
+            dload = step[n * n_sub:]
+            q += dq
+            load += dload
+            # Converged when both the loads and the compressions have settled (on a
+            # symmetric car the loads are right from the start; the compressions not).
+            d_delta = -flex @ dload - np.einsum('ks,cs->ck', hz, dq).ravel()
+            if (np.max(np.abs(dload)) < 1e-6 * self.p0
+                    and np.max(np.abs(d_delta)) < 1e-6 * d_min):
                 break
         else:
             raise DivergenceError('static equilibrium of the train on the track did not '
