@@ -60,6 +60,19 @@ all others.  No other eigenvalue sits at zero for a speed V > 0, so
 ``critical_speed`` can use the largest real part of the reduced spectrum
 without false crossings.
 
+Comparison with the time domain (open point)
+--------------------------------------------
+Table 1 car, scenario damper counts (4/2/2), no anti-yaw dampers, 300 km/h,
+LMA/CHN60 table: this analysis gives bogie hunting at 4.52 Hz with
+Re(lambda) = +1.41 1/s; ``TrainTrackCoupling`` on the slab track gives
+4.27 Hz and +3.0 1/s, the same for 0.3 and 3 mm initial offsets, dt = 1e-4
+and 2e-4 s and a 100 times stiffer lateral fastener.  With the default
+anti-yaw dampers the time domain also decays more slowly (about -2.8 vs
+-3.5 1/s).  The signs (and so the stable/unstable verdicts at 200, 300 and
+400 km/h) agree; the rates do not yet.  Not modelled here: the vertical
+and torsional flexibility of the track and the Shen-Hedrick-Elkins factor
+(its derivative at the static state is 0.91 on the lateral creep force).
+
 Functions
 ---------
 * :func:`conicity_geometry`, :func:`table_geometry` -- linearised geometry.
