@@ -1,0 +1,654 @@
+# Copyright 2026 The ttb_sim Authors
+#
+# Licensed under the Apache License, Version 2.0 (the "License");
+# you may not use this file except in compliance with the License.
+# You may obtain a copy of the License at
+#
+#     http://www.apache.org/licenses/LICENSE-2.0
+#
+# Unless required by applicable law or agreed to in writing, software
+# distributed under the License is distributed on an "AS IS" BASIS,
+# WITHOUT WARRANTIES OR CONDITIONS OF ANY KIND, either express or implied.
+# See the License for the specific language governing permissions and
+# limitations under the License.
+
+"""
+Linear lateral stability (hunting) of one multibody car on rigid, straight, smooth track.
+
+The car of :mod:`ttb_sim.model.car` is linearised at speed V about the
+centred static state (every wheelset at y = 0, every wheel load P0):
+
+    M q'' + (C + G(V) + C_c(V)) q' + (K + K_c) q = 0
+
+M, C, K are the suspension matrices of the car, G(V) its wheelset
+gyroscopic matrix (:func:`ttb_sim.model.car.gyroscopic_matrix`) and C_c, K_c
+the linearised wheel-rail contact of :func:`contact_matrices`.  The contact
+laws are those of the time-domain solver
+(:meth:`ttb_sim.sim.ttbi.TrainTrackCoupling.step`) with the rails held
+fixed, so this is an independent check of that implementation:
+
+* Hertz: Fz = ((rail_z - wheel_z + height(y)) / G)^(3/2), linearised to
+  dFz = k_H (height'(0) y - hz q), k_H = 1.5 P0^(1/3) / G;
+* lateral: Fy = -eps (f22 xi_y + f23 xi_sp) - s tan(gamma(y)) Fz;
+* longitudinal: Fx = -eps f11 xi_x; spin moment Mz = eps (f23 xi_y - f33 xi_sp);
+* creepages xi_x = hx q' / V + 1 - r(y) / r0, xi_y = hy q' / V - yaw,
+  xi_sp = yaw' cos(gamma) / V - s sin(gamma(y)) / r0;
+* creep coefficients of the Hertz ellipse at P0 (``ct.hertz_ellipse`` with the
+  solver's default curvatures), scaled with the wheel load as
+  (P / P0)^(2/3, 2/3, 1, 4/3) for f11, f22, f23, f33.
+
+y is the wheelset lateral displacement (the geometry argument of the
+solver), s = +1 for the left and -1 for the right wheel, and r(y), gamma(y),
+height(y) come from the profile table or from the equivalent cone
+(:class:`LinearGeometry`).  The saturation factor eps is 1 (linear Kalker)
+unless ``creep_factor`` is given; the time-domain solver's Shen-Hedrick-Elkins
+factor at the static state is 1 - beta0 / 3 with beta0 = |f23 sin(gamma0)| /
+(r0 mu P0) (about 2 % below 1 for the LMA/CHN60 table).
+
+Rigid-body roots.  The wheelset spin angles (the wheelset ``pitch`` DOFs) and
+the rigid longitudinal motion of the whole car produce no force at all (only
+their velocities appear, through the longitudinal creepage), so K + K_c is
+singular and the quadratic eigenproblem has that many exact zero roots, which
+numerically come out as +-1e-9-sized numbers of either sign.  They are removed
+exactly, not by a threshold on the eigenvalues: with N an orthonormal basis of
+the null space of K + K_c and W one of its row space (both from one SVD),
+(K + K_c) q = (K + K_c) W p with p = W^T q, and the state (p, u = q') obeys
+p' = W^T u, M u' = -(C + G + C_c) u - (K + K_c) W p.  The discarded
+coordinates a = N^T q only integrate N^T u and feed back nowhere, so they
+carry exactly the zero roots; the reduced state of size 2 n - n0 carries
+all others.  No other eigenvalue sits at zero for a speed V > 0, so
+``critical_speed`` can use the largest real part of the reduced spectrum
+without false crossings.
+
+Comparison with the time domain (open point)
+--------------------------------------------
+Table 1 car, scenario damper counts (4/2/2), no anti-yaw dampers, 300 km/h,
+LMA/CHN60 table: this analysis gives bogie hunting at 4.52 Hz with
+Re(lambda) = +1.41 1/s; ``TrainTrackCoupling`` on the slab track gives
+4.27 Hz and +3.0 1/s, the same for 0.3 and 3 mm initial offsets, dt = 1e-4
+and 2e-4 s and a 100 times stiffer lateral fastener.  With the default
+anti-yaw dampers the time domain also decays more slowly (about -2.8 vs
+-3.5 1/s).  The signs (and so the stable/unstable verdicts at 200, 300 and
+400 km/h) agree; the rates do not yet.  Not modelled here: the vertical
+and torsional flexibility of the track and the Shen-Hedrick-Elkins factor
+(its derivative at the static state is 0.91 on the lateral creep force).
+
+Functions
+---------
+* :func:`conicity_geometry`, :func:`table_geometry` -- linearised geometry.
+* :func:`contact_matrices` -- C_c and K_c, every term documented.
+* :func:`linear_car` -- the total matrices at one speed, optionally without
+  suspension or on a DOF subset.
+* :func:`eigen`, :func:`modes`, :func:`least_damped_mode` -- the spectrum.
+* :func:`critical_speed` -- coarse scan plus Brent bisection.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+import logging
+import math
+from typing import Sequence
+
+import numpy as np
+import scipy.linalg
+from scipy.optimize import brentq
+
+from ttb_sim.errors import ScenarioError
+from ttb_sim.model import contact as ct
+from ttb_sim.model.car import (CarParameters, contact_map, damping_matrix, DOF_PER_BODY,
+                               dofs as car_dofs, gyroscopic_matrix, mass_matrix, N_BODIES,
+                               N_DOF, stiffness_matrix, WHEELSETS)
+from ttb_sim.model.profiles import contact_geometry_table, ContactGeometryTable
+
+log = logging.getLogger(__name__)
+
+__all__ = [
+    'GEOMETRY_STEP',
+    'LATERAL_DOFS',
+    'LinearCar',
+    'LinearGeometry',
+    'Mode',
+    'NULL_TOLERANCE',
+    'conicity_geometry',
+    'contact_matrices',
+    'critical_speed',
+    'eigen',
+    'least_damped_mode',
+    'linear_car',
+    'max_real_part',
+    'modes',
+    'table_geometry',
+]
+
+#: Half-width (m) of the central differences of the profile table at y = 0.
+GEOMETRY_STEP = 1e-3
+#: Relative singular-value threshold defining the null space of K + K_c.
+NULL_TOLERANCE = 1e-9
+#: Lateral DOFs of the car (y, roll, yaw of every body), for mode classification.
+LATERAL_DOFS = car_dofs(range(N_BODIES), ['y', 'roll', 'yaw'])
+# Exponents of the Hertz load scaling of f11, f22, f23, f33 (ct.scale_creep_coefficients).
+_LOAD_EXPONENTS = (2.0 / 3.0, 2.0 / 3.0, 1.0, 4.0 / 3.0)
+
+
+@dataclass(frozen=True)
+class LinearGeometry:
+    """
+    Contact geometry of the two wheels of a wheelset, linearised at y = 0.
+
+    Arrays have shape (2,): left wheel (s = +1), right wheel (s = -1); y is the
+    wheelset lateral displacement (m, to the left).
+
+    Attributes
+    ----------
+    radius : numpy.ndarray
+        Rolling radius r_s(0) (m).
+    radius_slope : numpy.ndarray
+        dr_s/dy (-); +lambda, -lambda for an equivalent cone.
+    angle : numpy.ndarray
+        Contact angle gamma_s(0) (rad), > 0 towards the track centre.
+    angle_slope : numpy.ndarray
+        dgamma_s/dy (rad/m).
+    height_slope : numpy.ndarray
+        d height_s/dy (-) of the rigid-contact wheel height of the solver.
+    nominal_radius : float
+        r0 (m).
+
+    """
+
+    radius: np.ndarray
+    radius_slope: np.ndarray
+    angle: np.ndarray
+    angle_slope: np.ndarray
+    height_slope: np.ndarray
+    nominal_radius: float
+
+
+def conicity_geometry(conicity: float, nominal_radius: float = 0.46, *,
+                      contact_angle: float | None = None,
+                      knife_edge: bool = True) -> LinearGeometry:
+    """
+    Return the equivalent-cone geometry of the solver's ``geometry = 'conicity'``.
+
+    r_s = r0 + s lambda y, gamma = arctan(lambda) on both wheels (constant) and
+    height_s = r_s - r0 (knife-edge rails), as ``TrainTrackCoupling._geometry``.
+
+    Parameters
+    ----------
+    conicity : float
+        Equivalent conicity lambda (-), 0..1.
+    nominal_radius : float
+        r0 (m).
+    contact_angle : float, optional
+        Override of the (constant) contact angle (rad).  0 gives the pure
+        kinematic wheelset of Klingel: no lateral component of the normal
+        force and no static spin creepage.
+    knife_edge : bool
+        True (the solver): height_s = s lambda y, so the wheelset rolls by
+        lambda y / b and the lateral creepage sees the contact-point velocity
+        y' + r0 roll' = (1 + r0 lambda / b) y'.  False: height slope 0, the
+        wheelset stays level, as in Klingel's derivation.
+
+    Returns
+    -------
+    LinearGeometry
+        The linearised geometry.
+
+    """
+    g = ct.simplified_geometry(0.0, conicity, nominal_radius)
+    angle = float(g.contact_angle[0]) if contact_angle is None else float(contact_angle)
+    if not (math.isfinite(angle) and abs(angle) < 0.5 * math.pi):
+        raise ScenarioError(f'contact_angle = {contact_angle!r} rad is invalid; '
+                            'allowed: |angle| < pi/2')
+    side = np.array([1.0, -1.0])
+    return LinearGeometry(radius=np.asarray(g.rolling_radius, dtype=float),
+                          radius_slope=side * conicity, angle=np.full(2, angle),
+                          angle_slope=np.zeros(2),
+                          height_slope=side * conicity if knife_edge else np.zeros(2),
+                          nominal_radius=float(nominal_radius))
+
+
+def table_geometry(table: ContactGeometryTable | None = None, semi_distance: float = 0.7465,
+                   step: float = GEOMETRY_STEP) -> LinearGeometry:
+    """
+    Return the profile-table geometry linearised by central differences at y = 0.
+
+    Uses the same lookups as the solver (``wheelset_geometry`` and
+    ``wheel_height(y, b)``); the table is piecewise linear, so the slope is a
+    secant over +-``step``, which for the LMA/CHN60 table changes by < 0.1 %
+    between 0.1 and 3 mm.
+
+    Parameters
+    ----------
+    table : ContactGeometryTable, optional
+        The table; the default LMA/CHN60 table if omitted.
+    semi_distance : float
+        Arm b of the wheel heights (m), the car's contact semi-distance.
+    step : float
+        Half-width of the central differences (m), > 0.
+
+    Returns
+    -------
+    LinearGeometry
+        The linearised geometry.
+
+    """
+    if not (math.isfinite(step) and step > 0.0):
+        raise ScenarioError(f'geometry step = {step!r} m is invalid; allowed: finite and > 0')
+    tb = table if table is not None else contact_geometry_table()
+    y = np.array([-step, 0.0, step])
+    g = tb.wheelset_geometry(y)
+    h = tb.wheel_height(y, semi_distance)
+
+    def slope(a: np.ndarray) -> np.ndarray:
+        return (a[2] - a[0]) / (2.0 * step)
+
+    return LinearGeometry(radius=g.rolling_radius[1], radius_slope=slope(g.rolling_radius),
+                          angle=g.contact_angle[1], angle_slope=slope(g.contact_angle),
+                          height_slope=slope(h), nominal_radius=float(tb.nominal_radius))
+
+
+def contact_matrices(params: CarParameters | None, speed: float, geometry: LinearGeometry, *,
+                     tread: str = 'lm', creep_factor: float = 1.0
+                     ) -> tuple[np.ndarray, np.ndarray]:
+    """
+    Return the linearised contact damping C_c and stiffness K_c (42 x 42) on rigid rails.
+
+    Per contact k (side s, wheelset lateral DOF y_k = S_k q, maps hx, hy, hz,
+    hyaw of :class:`ttb_sim.model.car.ContactMap`) the force perturbations are
+
+    * normal: dFz = Z q with Z = k_H (height' S - hz) (Hertz tangent at P0);
+    * longitudinal: dFx = -f11 (hx q' / V - r' / r0 S q)
+      - (2/3) f11 xi_x0 dFz / P0, with the static creepage
+      xi_x0 = 1 - r(0) / r0 (rolling-radius difference);
+    * lateral: dFy = -f22 (hy q' / V - hyaw q)
+      - f23 (cos(gamma0) hyaw q' / V - s cos(gamma0) gamma' / r0 S q)
+      - f23 xi_sp0 dFz / P0 - s tan(gamma0) dFz - s P0 gamma' / cos^2(gamma0) S q,
+      with xi_sp0 = -s sin(gamma0) / r0.  The last two terms are the
+      gravitational stiffness (lateral component of the normal force), the
+      gamma' term of the spin creepage is the spin-creep stiffness that
+      opposes it, and the dFz / P0 term is the load scaling of f23 acting on
+      the static spin creepage;
+    * spin moment: dMz = f23 (hy q' / V - hyaw q)
+      - f33 (cos(gamma0) hyaw q' / V - s cos(gamma0) gamma' / r0 S q)
+      - (4/3) f33 xi_sp0 dFz / P0.
+
+    The static lateral creepage is 0, so the load scaling of f22 adds nothing.
+    The generalised force hx^T dFx + hy^T dFy + hz^T dFz + hyaw^T dMz
+    = -C_c q' - K_c q.
+
+    Parameters
+    ----------
+    params : CarParameters or None
+        Car parameters; Table 1 defaults if None.
+    speed : float
+        V (m/s), > 0.
+    geometry : LinearGeometry
+        Linearised contact geometry.
+    tread : {'lm', 'conical'}
+        Tread of Zhai's Hertz constant (``contact.tread``).
+    creep_factor : float
+        Factor eps on every creep coefficient (1 = linear Kalker), > 0.
+
+    Returns
+    -------
+    damping, stiffness : numpy.ndarray
+        C_c and K_c (42 x 42, not symmetric).
+
+    """
+    p = params or CarParameters()
+    if not (math.isfinite(speed) and speed > 0.0):
+        raise ScenarioError(f'speed = {speed!r} m/s is invalid; allowed: finite and > 0')
+    if not (math.isfinite(creep_factor) and creep_factor > 0.0):
+        raise ScenarioError(f'creep_factor = {creep_factor!r} is invalid; allowed: > 0')
+    cm = contact_map(p)
+    r0 = p.wheel_radius
+    p0 = p.static_wheel_load
+    k_h = float(ct.linearised_stiffness(p0, ct.hertz_constant(r0, tread)))
+    ellipse = ct.hertz_ellipse(p0, r0)
+    f11, f22, f23, f33 = (creep_factor * float(f)
+                          for f in ct.creep_coefficients(ellipse.a, ellipse.b))
+    n11, _, n23, n33 = _LOAD_EXPONENTS
+    # Per-contact geometry (column 0 = left, 1 = right wheel).
+    col = np.where(cm.side > 0, 0, 1)
+    s = cm.side.astype(float)[:, None]
+    r, dr = geometry.radius[col][:, None], geometry.radius_slope[col][:, None]
+    gam, dgam = geometry.angle[col][:, None], geometry.angle_slope[col][:, None]
+    dh = geometry.height_slope[col][:, None]
+    cos_g, tan_g = np.cos(gam), np.tan(gam)
+    xi_x0 = 1.0 - r / r0
+    xi_sp0 = -s * np.sin(gam) / r0
+    sel = np.zeros((8, N_DOF))                     # S: wheelset lateral DOF of each contact
+    sel[np.arange(8), DOF_PER_BODY * np.asarray(WHEELSETS)[cm.wheelset] + 1] = 1.0
+    hx, hy, hz, hyaw = cm.hx, cm.hy, cm.hz, cm.hyaw
+    v = float(speed)
+    # Force rows: dF = D q' + E q, each (8, 42).
+    e_z = k_h * (dh * sel - hz)
+    d_x = -f11 * hx / v
+    e_x = f11 * dr / r0 * sel - n11 * f11 * xi_x0 * e_z / p0
+    spin_y = s * cos_g * dgam / r0 * sel            # -(d xi_sp / dq) (displacement part)
+    d_y = -f22 * hy / v - f23 * cos_g * hyaw / v
+    e_y = (f22 * hyaw + f23 * spin_y - n23 * f23 * xi_sp0 * e_z / p0
+           - s * tan_g * e_z - s * p0 * dgam / cos_g ** 2 * sel)
+    d_m = f23 * hy / v - f33 * cos_g * hyaw / v
+    e_m = -f23 * hyaw - f33 * spin_y - n33 * f33 * xi_sp0 * e_z / p0
+    damping = -(hx.T @ d_x + hy.T @ d_y + hyaw.T @ d_m)
+    stiffness = -(hx.T @ e_x + hy.T @ e_y + hz.T @ e_z + hyaw.T @ e_m)
+    return damping, stiffness
+
+
+@dataclass(frozen=True)
+class LinearCar:
+    """
+    Linearised equations M q'' + C q' + K q = 0 of a car at one speed.
+
+    Attributes
+    ----------
+    mass, damping, stiffness : numpy.ndarray
+        Square matrices over ``dofs``; damping includes G(V) and C_c(V),
+        stiffness includes K_c.
+    dofs : numpy.ndarray
+        Car DOF indices (0..41) kept; the others are held fixed.
+    speed : float
+        V (m/s).
+
+    """
+
+    mass: np.ndarray
+    damping: np.ndarray
+    stiffness: np.ndarray
+    dofs: np.ndarray
+    speed: float
+
+
+def linear_car(params: CarParameters | None, speed: float, geometry: LinearGeometry, *,
+               tread: str = 'lm', creep_factor: float = 1.0, suspension: bool = True,
+               dofs: Sequence[int] | np.ndarray | None = None) -> LinearCar:
+    """
+    Build the linearised car on rigid track at speed V.
+
+    Parameters
+    ----------
+    params : CarParameters or None
+        Car parameters; Table 1 defaults if None.
+    speed : float
+        V (m/s), > 0.
+    geometry : LinearGeometry
+        Linearised contact geometry.
+    tread : {'lm', 'conical'}
+        Tread of the Hertz constant.
+    creep_factor : float
+        Factor on the creep coefficients (1 = linear Kalker).
+    suspension : bool
+        False drops the suspension K and C (keeps M, G(V) and the contact),
+        e.g. for a free wheelset together with ``dofs``.
+    dofs : sequence of int, optional
+        DOFs kept (others held at 0); all 42 if omitted.
+
+    Returns
+    -------
+    LinearCar
+        The matrices.
+
+    """
+    p = params or CarParameters()
+    c_c, k_c = contact_matrices(p, speed, geometry, tread=tread, creep_factor=creep_factor)
+    damping = gyroscopic_matrix(p, speed) + c_c
+    stiffness = k_c
+    if suspension:
+        damping = damping + damping_matrix(p)
+        stiffness = stiffness + stiffness_matrix(p)
+    idx = np.arange(N_DOF) if dofs is None else np.asarray(dofs, dtype=int)
+    sub = np.ix_(idx, idx)
+    return LinearCar(mass_matrix(p)[sub], damping[sub], stiffness[sub], idx, float(speed))
+
+
+def eigen(system: LinearCar) -> tuple[np.ndarray, np.ndarray]:
+    """
+    Return the eigenvalues and displacement shapes without the rigid-body zero roots.
+
+    The zero roots are removed exactly in two steps (module docstring):
+    positions that produce no force (null space of K), then steady
+    velocities in that null space whose damping force the stiffness balances
+    statically (the uniform change of forward speed with matching wheel
+    spin, which has zero creepage).
+
+    Parameters
+    ----------
+    system : LinearCar
+        Linearised equations.
+
+    Returns
+    -------
+    eigenvalues : numpy.ndarray
+        Complex, shape (2 n - n0 - n1,).
+    shapes : numpy.ndarray
+        Complex displacement shapes q = q' / lambda, shape (n, 2 n - n0 - n1),
+        normalised to unit kinetic-energy norm (sum m |q|^2 = 1).
+
+    """
+    m, c, k = system.mass, system.damping, system.stiffness
+    n = m.shape[0]
+    # Step 1: positions without force, K N = 0; keep p = W^T q.
+    _, sv, vt = scipy.linalg.svd(k)
+    rank = int(np.sum(sv > NULL_TOLERANCE * sv[0]))
+    w, null = vt[:rank].T, vt[rank:].T
+    m_inv = np.linalg.inv(m)
+    a = np.zeros((rank + n, rank + n))
+    a[:rank, rank:] = w.T
+    a[rank:, :rank] = -m_inv @ k @ w
+    a[rank:, rank:] = -m_inv @ c
+    basis = np.eye(rank + n)
+    if null.shape[1]:
+        # Step 2: states (p, u = N a) with K W p + C N a = 0 (kernel of the reduced matrix).
+        b = np.hstack([k @ w, c @ null])
+        scale = np.linalg.norm(b, axis=0)
+        scale[scale == 0.0] = 1.0
+        _, sv2, vt2 = scipy.linalg.svd(b / scale, full_matrices=True)
+        sv2 = np.concatenate([sv2, np.zeros(vt2.shape[0] - sv2.size)])
+        kernel = (vt2[sv2 <= NULL_TOLERANCE * sv2[0]] / scale).T      # (rank + n0, n1)
+        if kernel.shape[1]:
+            z = np.vstack([kernel[:rank], null @ kernel[rank:]])
+            basis = scipy.linalg.null_space(z.T)                     # orthonormal complement
+        log.debug('deflated %d force-free positions and %d steady velocities',
+                  n - rank, kernel.shape[1])
+    lam, vec = scipy.linalg.eig(basis.T @ a @ basis)
+    # With Q = [Z, Y] (Z the kernel), Q^T A Q = [[0, X], [0, T]]; an eigenvector v of
+    # T = Y^T A Y is the eigenvector Y v + Z X v / lambda of A.
+    full = basis @ vec
+    full = full + _kernel_part(a, basis, full, lam)
+    shapes = full[rank:] / lam[None, :]
+    norm = np.sqrt(np.einsum('i,ij->j', np.diag(m), np.abs(shapes) ** 2))
+    return lam, shapes / norm[None, :]
+
+
+def _kernel_part(a: np.ndarray, basis: np.ndarray, vec: np.ndarray,
+                 lam: np.ndarray) -> np.ndarray:
+    """Return the component of each eigenvector along the deflated kernel, Z X v / lambda."""
+    if basis.shape[1] == a.shape[0]:
+        return np.zeros_like(vec)
+    residual = a @ vec - basis @ (basis.T @ a @ vec)               # Z Z^T A Y v
+    return residual / lam[None, :]
+
+
+@dataclass(frozen=True)
+class Mode:
+    """
+    One complex mode of the linearised car.
+
+    Attributes
+    ----------
+    eigenvalue : complex
+        lambda (1/s); the motion grows as exp(Re(lambda) t).
+    frequency : float
+        Damped frequency |Im(lambda)| / 2 pi (Hz).
+    damping_ratio : float
+        -Re(lambda) / |lambda| (-); negative when unstable.
+    lateral_fraction : float
+        Share of the modal kinetic energy in the lateral DOFs (y, roll, yaw).
+    shape : numpy.ndarray
+        Complex displacement shape over the system's DOFs.
+
+    """
+
+    eigenvalue: complex
+    frequency: float
+    damping_ratio: float
+    lateral_fraction: float
+    shape: np.ndarray
+
+
+def modes(system: LinearCar) -> list[Mode]:
+    """
+    Return every mode (one per complex-conjugate pair), ascending damping ratio.
+
+    Parameters
+    ----------
+    system : LinearCar
+        Linearised equations.
+
+    Returns
+    -------
+    list of Mode
+        Oscillatory modes with Im(lambda) > 0 and real roots.
+
+    """
+    lam, shapes = eigen(system)
+    keep = lam.imag >= 0.0
+    lam, shapes = lam[keep], shapes[:, keep]
+    lateral = np.isin(system.dofs, LATERAL_DOFS)
+    energy = np.diag(system.mass)[:, None] * np.abs(shapes) ** 2
+    frac = energy[lateral].sum(axis=0) / energy.sum(axis=0)
+    zeta = -lam.real / np.abs(lam)
+    order = np.argsort(zeta)
+    return [Mode(complex(lam[i]), float(abs(lam[i].imag) / (2.0 * math.pi)), float(zeta[i]),
+                 float(frac[i]), shapes[:, i]) for i in order]
+
+
+def least_damped_mode(params: CarParameters | None, speed: float, geometry: LinearGeometry, *,
+                      lateral: bool = True, oscillatory: bool = True, **kwargs: object
+                      ) -> Mode:
+    """
+    Return the least-damped (lateral, oscillatory) mode at speed V.
+
+    Parameters
+    ----------
+    params : CarParameters or None
+        Car parameters; Table 1 defaults if None.
+    speed : float
+        V (m/s), > 0.
+    geometry : LinearGeometry
+        Linearised contact geometry.
+    lateral : bool
+        Only modes with more than half of their kinetic energy in lateral DOFs.
+    oscillatory : bool
+        Only complex modes (frequency > 0).
+    **kwargs
+        Passed to :func:`linear_car` (tread, creep_factor, suspension, dofs).
+
+    Returns
+    -------
+    Mode
+        The mode with the smallest damping ratio among the candidates.
+
+    Raises
+    ------
+    ScenarioError
+        If no mode qualifies.
+
+    """
+    candidates = [md for md in modes(linear_car(params, speed, geometry, **kwargs))
+                  if (md.lateral_fraction > 0.5 or not lateral)
+                  and (md.frequency > 0.0 or not oscillatory)]
+    if not candidates:
+        raise ScenarioError('no mode matches the selection (lateral / oscillatory)')
+    return candidates[0]
+
+
+def max_real_part(params: CarParameters | None, speed: float, geometry: LinearGeometry,
+                  **kwargs: object) -> float:
+    """
+    Return the largest real part of the non-rigid eigenvalues at speed V (1/s).
+
+    Parameters
+    ----------
+    params : CarParameters or None
+        Car parameters.
+    speed : float
+        V (m/s), > 0.
+    geometry : LinearGeometry
+        Linearised contact geometry.
+    **kwargs
+        Passed to :func:`linear_car`.
+
+    Returns
+    -------
+    float
+        max Re(lambda); > 0 means unstable.
+
+    """
+    lam, _ = eigen(linear_car(params, speed, geometry, **kwargs))
+    return float(np.max(lam.real))
+
+
+def critical_speed(params: CarParameters | None, geometry: LinearGeometry, *,
+                   speed_range: tuple[float, float] = (5.0, 200.0), n_scan: int = 40,
+                   tol: float = 0.01, **kwargs: object) -> float:
+    """
+    Return the lowest speed at which an eigenvalue crosses into Re(lambda) > 0.
+
+    The largest real part is evaluated on ``n_scan`` equally spaced speeds;
+    the first sign change is refined by Brent's method (``brentq``) to
+    ``tol``.  A stable window narrower than the scan spacing between two
+    unstable speeds could be missed; crossings are found to within ``tol``.
+
+    Parameters
+    ----------
+    params : CarParameters or None
+        Car parameters; Table 1 defaults if None.
+    geometry : LinearGeometry
+        Linearised contact geometry.
+    speed_range : tuple of float
+        Lowest and highest speed scanned (m/s), 0 < low < high.
+    n_scan : int
+        Number of scan speeds, >= 2.
+    tol : float
+        Absolute tolerance on the critical speed (m/s), > 0.
+    **kwargs
+        Passed to :func:`linear_car`.
+
+    Returns
+    -------
+    float
+        Critical speed (m/s); ``math.inf`` if stable over the whole range.
+
+    Raises
+    ------
+    ScenarioError
+        On invalid arguments, or if the car is already unstable at the lowest speed.
+
+    """
+    low, high = (float(v) for v in speed_range)
+    if not (math.isfinite(low) and math.isfinite(high) and 0.0 < low < high):
+        raise ScenarioError(f'speed_range = {speed_range!r} is invalid; allowed: 0 < low < high')
+    if int(n_scan) < 2 or not (math.isfinite(tol) and tol > 0.0):
+        raise ScenarioError(f'n_scan = {n_scan!r} / tol = {tol!r} are invalid; '
+                            'allowed: n_scan >= 2, tol > 0')
+
+    def growth(v: float) -> float:
+        return max_real_part(params, v, geometry, **kwargs)
+
+    speeds = np.linspace(low, high, int(n_scan))
+    previous = growth(speeds[0])
+    if previous > 0.0:
+        raise ScenarioError(f'the car is unstable already at {low:.3g} m/s '
+                            f'(max Re(lambda) = {previous:.3g} 1/s); lower speed_range')
+    for v0, v1 in zip(speeds[:-1], speeds[1:]):
+        current = growth(v1)
+        if current > 0.0:
+            v_cr = float(brentq(growth, v0, v1, xtol=tol))
+            log.info('critical speed %.3f m/s (%.2f km/h)', v_cr, 3.6 * v_cr)
+            return v_cr
+        previous = current
+    log.info('stable up to %.3f m/s (max Re(lambda) = %.3g 1/s)', high, previous)
+    return math.inf
