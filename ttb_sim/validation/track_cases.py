@@ -44,11 +44,13 @@ V2 (steady-state peak rail deflection, speed 180 km/h = 50 m/s, v / v_cr = 0.057
 
     Measured (rigid slab): peaks 0.62225 .. 0.62594 mm over the bay, mean
     0.62431 mm, -0.11 % from the closed form. The discrete support changes the
-    peak by -0.44 % .. +0.15 % of the closed form over the bay (largest near the
-    fastener, smallest at 3/8 of the bay: the fastener acts at the rail foot,
+    peak by -0.44 % .. +0.15 % of the closed form over the bay (largest at 7/8
+    of the bay, just before the next fastener in the running direction, and
+    smallest at 3/8; not explained here: the fastener acts at the rail foot,
     88 mm below the axis, so its longitudinal stiffness also resists the rail's
-    rotation); the row is the bay mean, the deflection a continuous support
-    would give. The wheel loads stay within 1.0 % of P0 over the bay.
+    rotation, which a Winkler beam lacks); the row is the bay mean, the
+    deflection a continuous support would give. The wheel loads stay within
+    1.0 % of P0 over the bay.
     With [P]'s layers (1.5e9 N/m^2, ``track.layer_stiffness``) the bay-mean rail
     peak is 0.70823 mm (+13.4 % over the rigid slab): the slab under the bogie
     sinks 0.0935 .. 0.0946 mm, and the rail deflection relative to the slab at
@@ -72,8 +74,8 @@ V6 (P2 resonance of the contact-force FRF, speed 72 km/h = 20 m/s)
     around the resonance (the broadband presets 'paper' and 'chinese_hsr' also
     carry alignment, gauge and cross-level, and no scenario key switches them
     off); its amplitude (A = 4.15e-8, scale 1, 24 um RMS) keeps the contact
-    force above 65 kN (P0 = 78.5 kN), close to linear. Fastener passing is at 31.7 and
-    63.5 Hz, away from 48 Hz. The FRF is the H1 estimate, the cross-spectral
+    force above 65 kN (P0 = 78.5 kN), close to linear. Fastener passing is at
+    31.7 and 63.5 Hz, away from 48 Hz. The FRF is the H1 estimate, the cross-spectral
     density of irregularity (under each wheel, from the run's own realised
     profile) and vertical contact force over the irregularity's auto-spectral
     density, both summed over the 8 wheels (Welch, Hann segments), after the
@@ -81,10 +83,11 @@ V6 (P2 resonance of the contact-force FRF, speed 72 km/h = 20 m/s)
     (:func:`ttb_sim.analysis.psd.peak_frequency`) in 20-150 Hz.
 
     Measured (rigid slab; closed form 47.80 Hz): the full case (2 s record,
-    0.4 s segments, 2.5 Hz bins) gave 47.90 Hz (+0.22 %) with a 75 m approach,
-    coherence 0.88-0.98 over 30-60 Hz and above 0.99 from 70 Hz up; the fast
-    test (0.6 s, 0.2 s segments) gives 47.37 Hz (-0.9 %), with the coherence
-    down to 0.6 at 40 Hz (short segments against a resonance a few bins wide:
+    0.4 s segments, 2.5 Hz bins, 65.2 m approach) gives 47.86 Hz (+0.13 %);
+    the same with a 75 m approach (another realisation of the profile) gave
+    47.90 Hz (+0.22 %), coherence 0.88-0.98 over 30-60 Hz and above 0.99 from
+    70 Hz up. The fast test (0.6 s, 0.2 s segments) gives 47.37 Hz (-0.9 %),
+    with the coherence down to 0.6 at 40 Hz (short segments against a resonance a few bins wide:
     H1 resolution bias). Shorter segments on a 1.2 s record (0.1-0.125 s) put
     the peak at 52-54 Hz: the segment must resolve the resonance.
 
@@ -480,7 +483,7 @@ def _v6(overrides: Sequence[str] = ()) -> list[Row]:
 
 
 TRACK_CASES = (
-    Case('V2', 'infinite Winkler beam: car on the approach track, rigid slab (about 30 s)',
+    Case('V2', 'infinite Winkler beam: car on the approach track, rigid slab (about 12 s)',
          _v2),
-    Case('V6', 'P2 resonance of the contact-force FRF, Sato roughness (about 2 min)', _v6),
+    Case('V6', 'P2 resonance of the contact-force FRF, Sato roughness (about 80 s)', _v6),
 )
