@@ -100,7 +100,7 @@ def test_thick_simply_supported_plate_matches_mindlin_closed_form():
 
 def _free_plate(foundation: float):
     plate = MindlinPlate(thickness=0.2, young=3e10, poisson=0.2, density=2500.0)
-    mesh = rectangular_mesh(np.linspace(0.0, 4.0, 13), np.linspace(-1.0, 1.0, 7))
+    mesh = rectangular_mesh(np.linspace(0.0, 4.0, 9), np.linspace(-1.0, 1.0, 5))
     k, m = plate_matrices(mesh, plate, foundation)
     w2 = la.eigh(k.toarray(), m.toarray(), eigvals_only=True)
     return plate, mesh, k, m, w2
@@ -110,7 +110,7 @@ def test_free_plate_has_three_rigid_modes_only():
     _, _, _, _, w2 = _free_plate(0.0)
     scale = w2[-1]
     assert np.sum(np.abs(w2) < 1e-10 * scale) == 3
-    # The first elastic mode (about 45 Hz here) is far from zero.
+    # The first elastic mode (about 46 Hz here) is far from zero.
     assert w2[3] > 1e-6 * scale
 
 
