@@ -34,6 +34,7 @@ from ttb_sim.validation.component_cases import COMPONENT_CASES
 from ttb_sim.validation.references import (Beam, fryba_peak, QuarterCar,
                                            sprung_mass_modal)
 from ttb_sim.validation.rows import Case, relative_row, Row
+from ttb_sim.validation.slab_plate import SLAB_PLATE_CASES
 from ttb_sim.validation.system_cases import SYSTEM_CASES
 from ttb_sim.validation.track_cases import TRACK_CASES
 
@@ -163,7 +164,9 @@ CASES: dict[str, Case] = {c.case_id: c for c in sorted((
     Case('V1', 'moving constant force on a simply supported beam (Fryba)', _v1),
     Case('V3', 'sprung mass crossing a simply supported beam (Yang & Yau)', _v3),
     Case('V7', 'Newmark average acceleration: order and energy', _v7),
-    *COMPONENT_CASES, *SYSTEM_CASES, *TRACK_CASES), key=lambda c: int(c.case_id[1:]))}
+    *COMPONENT_CASES, *SLAB_PLATE_CASES, *SYSTEM_CASES, *TRACK_CASES),
+    key=lambda c: (c.case_id[0] != 'V', int(c.case_id[1:])))}
+"""Cases by id: V* are VALIDATION.md's, X* are extra checks of modelling choices."""
 
 
 def run_cases(case_ids: Sequence[str]) -> list[Row]:
