@@ -58,6 +58,20 @@ def test_static_start_carries_the_static_wheel_load(smooth_run):
     assert np.max(np.abs(start - p0)) < 0.025 * p0
 
 
+def test_static_start_on_irregular_track():
+    """
+    On the paper's irregularity the first step changes no wheel load by more than 5 %.
+
+    The static start includes the rigid-contact height change from the lateral
+    irregularity under the centred wheelsets (measured 1.7 %; 34 % without it).
+    """
+    sim = small_car(0.0005, [('irregularity.spectrum', 'paper'), ('irregularity.seed', 3),
+                             ('output.rate_hz', 0.0)])
+    frames = list(sim.frames())
+    first, second = (f.wheel_rail[0, :, :, 2] for f in frames[:2])
+    assert np.max(np.abs(second - first)) < 0.05 * sim.train_track.p0
+
+
 def test_static_equilibrium_satisfies_hertz():
     """The static start's loads are Hertz's law of its compressions (77.4 um at P0, LM)."""
     sim = small_car(0.01)

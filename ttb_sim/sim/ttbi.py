@@ -71,9 +71,9 @@ log = logging.getLogger(__name__)
 PROBE_SPACING = 24
 """Rail nodes between simultaneous probes of the local track compliance."""
 COMPONENTS = 4
+"""Contact force components per wheel: Fx, Fy, Fz (on the wheel), Mz (spin moment)."""
 GEOMETRY_STEP = 1e-6
 """Lateral step (m) of the central difference of the rigid-contact wheel height."""
-"""Contact force components per wheel: Fx, Fy, Fz (on the wheel), Mz (spin moment)."""
 
 
 def car_parameters(scenario: Scenario) -> CarParameters:
@@ -313,12 +313,18 @@ class TrainTrackCoupling:
         Vertical problem only (the train is symmetric and the track straight):
         Newton on the car DOFs and the wheel loads, with the exact static track
         flexibility under the wheels (one static factorisation, one solve per wheel).
+        The wheelsets stand centred on the track; vertical irregularity and the
+        rigid-contact height change caused by lateral irregularity are included.
         """
         st = self.structure
         n = self.n_cars
         x = head + self.contact_x
         rows, _, dofs, _ = self._rail_rows(x)
-        irr_z, _, _ = self._irregularity(x)
+        irr_z, irr_y, _ = self._irregularity(x)
+        # The wheelsets start centred on the track (y = 0): with lateral irregularity
+        # the rails are shifted under them, which raises or lowers each wheel's
+        # rigid-contact height; the static loads and attitude take that in.
+        irr_z = irr_z + self._geometry(-irr_y)[2]
         n_free = st.n_free
         m = 8 * n
         lu = sla.splu(st.stiffness.tocsc())
