@@ -407,8 +407,8 @@ class FoundationConfig:
 class IrregularityConfig:
     """Track irregularity (applied under quarter cars; moving forces ignore it)."""
 
-    spectrum: str = param('none', '-', "Irregularity spectrum ('paper' = Chinese HSR 1-50 m "
-                          "plus Sato 0.05-1 m); 'none' is a smooth track.",
+    spectrum: str = param('none', '-', "Irregularity spectrum ('paper' = Chinese HSR vertical "
+                          "and alignment 1-50 m plus Sato 0.05-1 m); 'none' is a smooth track.",
                           choices=('none', 'paper', 'chinese_hsr', 'sato', 'german_low',
                                    'german_high', 'fra1', 'fra2', 'fra3', 'fra4', 'fra5',
                                    'fra6'), dynamic=True)

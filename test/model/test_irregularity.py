@@ -73,18 +73,20 @@ def test_v8_paper_preset_adds_chinese_and_sato():
     """
     V8 for the paper preset: vertical variance = Chinese (1-50 m) + Sato (0.05-1 m).
 
-    Reference: quad of the two PSDs; other components: Chinese alone.
-    Tolerance: 2 %.  One realisation over a whole FFT record (8 x 50 m) is
-    enough because the record variance is deterministic: measured error < 1e-12
-    for alignment, cross-level and gauge, 1e-5 for vertical, where the one FFT
-    bin containing n = 1/m is shared by the two layers with independent phases
-    (their cross term is the only deviation from additivity).
+    Reference: quad of the two PSDs; alignment: Chinese alone; cross-level and
+    gauge: zero (the preset has none).  Tolerance: 2 %.  One realisation over a
+    whole FFT record (8 x 50 m) is enough because the record variance is
+    deterministic: measured error < 1e-12 for alignment, 1e-5 for vertical,
+    where the one FFT bin containing n = 1/m is shared by the two layers with
+    independent phases (their cross term is the only deviation from additivity).
     """
     prof = irr.synthesize('paper', length=400.0, dx=0.01, seed=3)
     chinese = spectra.SPECTRA['chinese_hsr'].components
     sato = spectra.SPECTRA['sato'].components['vertical']
-    expected = {c: quad_variance(chinese[c], 1.0, 50.0) for c in spectra.COMPONENTS}
+    expected = {c: quad_variance(chinese[c], 1.0, 50.0) for c in ('vertical', 'alignment')}
     expected['vertical'] += quad_variance(sato, 0.05, 1.0)
+    for c in ('cross_level', 'gauge'):
+        assert not np.any(prof.geometry(c))
     for c, var in expected.items():
         assert np.var(prof.geometry(c)) == pytest.approx(var, rel=0.02)
         exact = 1e-4 if c == 'vertical' else 1e-8
@@ -184,14 +186,18 @@ def test_rail_composition_and_signs():
 
 def test_paper_preset_sato_is_common_to_both_rails():
     """
-    Paper preset = Chinese 1-50 m + Sato 0.05-1 m added to the vertical of both rails.
+    Paper preset = Chinese vertical + alignment 1-50 m + Sato 0.05-1 m on both rails' vertical.
 
     Reference: the Chinese layer synthesised alone with the same seed (its
     random streams do not depend on the other layers). Tolerance: 1e-15 m.
+    Without cross-level and gauge both rails carry the same profile and alignment.
     """
     kw = {'length': 60.0, 'dx': 0.01, 'seed': 8}
     paper = irr.synthesize('paper', **kw)
-    chinese = irr.synthesize([irr.IrregularityLayer('chinese_hsr', 1.0, 50.0)], **kw)
+    chinese = irr.synthesize([irr.IrregularityLayer('chinese_hsr', 1.0, 50.0,
+                                                    ('vertical', 'alignment'))], **kw)
+    np.testing.assert_array_equal(paper.values[0], paper.values[1])
+    np.testing.assert_array_equal(paper.values[2], paper.values[3])
     extra = paper.values - chinese.values
     np.testing.assert_allclose(extra[0], extra[1], atol=1e-15)
     np.testing.assert_allclose(extra[2:], 0.0, atol=1e-15)
@@ -203,9 +209,9 @@ def test_paper_preset_sato_is_common_to_both_rails():
 def test_same_seed_is_bit_identical_and_other_seed_differs():
     """Determinism: equal seeds give identical arrays bit for bit; seeds 1 and 2 differ."""
     kw = {'length': 120.0, 'dx': 0.02}
-    a = irr.synthesize('paper', seed=1, **kw)
-    b = irr.synthesize('paper', seed=1, **kw)
-    c = irr.synthesize('paper', seed=2, **kw)
+    a = irr.synthesize('chinese_hsr', seed=1, **kw)
+    b = irr.synthesize('chinese_hsr', seed=1, **kw)
+    c = irr.synthesize('chinese_hsr', seed=2, **kw)
     for name in ('values', 'slopes', 'curvatures'):
         assert getattr(a, name).tobytes() == getattr(b, name).tobytes()
         assert not np.any(getattr(a, name) == getattr(c, name))

@@ -144,11 +144,16 @@ class IrregularityLayer:
     components: tuple[str, ...] | None = None
 
 
-#: Named combinations of spectra.  ``paper``: [P] section 4.1, the Chinese
-#: HSR spectrum over 1-50 m wavelength plus Sato (A = 4.15e-8) over 0.05-1 m.
+#: Named combinations of spectra.  ``paper``: [P] section 4.1 and its Fig. 11,
+#: the Chinese HSR vertical profile and alignment over 1-50 m wavelength (one
+#: vertical and one lateral series, the same under both rails: [P] shows no
+#: cross-level or gauge) plus Sato vertical roughness (A = 4.15e-8) over
+#: 0.05-1 m on both rails.  At 1 m the vertical PSD rises 2.7 times from the
+#: Chinese to the Sato spectrum (PHYSICS.md 1.2); with TB/T 3352 cross-level
+#: extrapolated to 1 m on top, each rail's PSD would instead fall there.
 PRESETS: Mapping[str, tuple[IrregularityLayer, ...]] = MappingProxyType({
     'paper': (
-        IrregularityLayer('chinese_hsr', 1.0, 50.0),
+        IrregularityLayer('chinese_hsr', 1.0, 50.0, ('vertical', 'alignment')),
         IrregularityLayer('sato', 0.05, 1.0),
     ),
 })
