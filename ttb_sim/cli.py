@@ -138,7 +138,7 @@ def _cmd_run(args: argparse.Namespace) -> int:
               'frames', file=sys.stderr)
         return EXIT_FAILURE
     print(f'{out}: {s["frames"]} frames, {s["simulated_time"]:.3f} s simulated in '
-          f'{s["wall_time"]:.2f} s (real-time factor {s["real_time_factor"]:.2f})')
+          f'{s["wall_time"]:.2f} s (real-time factor {s["real_time_factor"]:.3g})')
     return EXIT_OK
 
 

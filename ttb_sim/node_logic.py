@@ -722,7 +722,7 @@ class PassageController:
                 ('state', self.state),
                 ('passage', str(self.passage)),
                 ('simulation time (s)', f'{self._node_time:.6f}'),
-                ('real-time factor', f'{rtf:.3f}'),
+                ('real-time factor', f'{rtf:.3g}'),
                 ('real-time factor target (0 = max)', f'{target:g}'),
                 ('step time (ms)', f'{step_ms:.4f}'),
                 ('solver dt (s)', f'{self.sim.dt:.6g}'),
