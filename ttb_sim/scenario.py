@@ -408,8 +408,10 @@ class IrregularityConfig:
     """Track irregularity (applied under quarter cars; moving forces ignore it)."""
 
     spectrum: str = param('none', '-', "Irregularity spectrum ('paper' = Chinese HSR vertical "
-                          "and alignment 1-50 m plus Sato 0.05-1 m); 'none' is a smooth track.",
-                          choices=('none', 'paper', 'chinese_hsr', 'sato', 'german_low',
+                          "and alignment 1-50 m plus Sato 0.05-1 m; 'chinese_sato' the same with "
+                          "1-200 m); 'none' is a smooth track.",
+                          choices=('none', 'paper', 'chinese_sato', 'chinese_hsr', 'sato',
+                                   'german_low',
                                    'german_high', 'fra1', 'fra2', 'fra3', 'fra4', 'fra5',
                                    'fra6'), dynamic=True)
     seed: int = param(1, '-', 'Seed of the random phases (same seed, same track).', low=0,

@@ -93,6 +93,23 @@ def test_v8_paper_preset_adds_chinese_and_sato():
         assert np.var(prof.geometry(c)) == pytest.approx(var, rel=exact)
 
 
+def test_chinese_sato_preset_extends_the_chinese_band_to_200_m():
+    """
+    chinese_sato = paper preset with the Chinese layer over 1-200 m (V8 variance, 2 %).
+
+    One realisation over a whole FFT record (8 x 200 m) has the deterministic
+    record variance (as for the paper preset above).
+    """
+    prof = irr.synthesize('chinese_sato', length=1600.0, dx=0.02, seed=5)
+    chinese = spectra.SPECTRA['chinese_hsr'].components
+    sato = spectra.SPECTRA['sato'].components['vertical']
+    vertical = quad_variance(chinese['vertical'], 1.0, 200.0) + quad_variance(sato, 0.05, 1.0)
+    assert np.var(prof.geometry('vertical')) == pytest.approx(vertical, rel=0.02)
+    assert np.var(prof.geometry('alignment')) == pytest.approx(
+        quad_variance(chinese['alignment'], 1.0, 200.0), rel=0.02)
+    assert not np.any(prof.geometry('cross_level')) and not np.any(prof.geometry('gauge'))
+
+
 def octave_ratios(family: str, component: str) -> list[float]:
     """Welch PSD / target PSD averaged over octave bands inside the default band."""
     comp = spectra.SPECTRA[family].components[component]

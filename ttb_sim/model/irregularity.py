@@ -151,9 +151,15 @@ class IrregularityLayer:
 #: 0.05-1 m on both rails.  At 1 m the vertical PSD rises 2.7 times from the
 #: Chinese to the Sato spectrum (PHYSICS.md 1.2); with TB/T 3352 cross-level
 #: extrapolated to 1 m on top, each rail's PSD would instead fall there.
+#: ``chinese_sato``: the same with the Chinese layer over 1-200 m, so that
+#: wavelengths beyond 50 m (below 1.67 Hz at 300 km/h) excite the car body.
 PRESETS: Mapping[str, tuple[IrregularityLayer, ...]] = MappingProxyType({
     'paper': (
         IrregularityLayer('chinese_hsr', 1.0, 50.0, ('vertical', 'alignment')),
+        IrregularityLayer('sato', 0.05, 1.0),
+    ),
+    'chinese_sato': (
+        IrregularityLayer('chinese_hsr', 1.0, 200.0, ('vertical', 'alignment')),
         IrregularityLayer('sato', 0.05, 1.0),
     ),
 })
