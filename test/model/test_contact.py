@@ -221,6 +221,25 @@ def test_she_factor_derivative_matches_finite_differences():
     assert contact.she_factor_derivative(3.0 + 1e-12) == pytest.approx(-1.0 / 9.0, rel=1e-9)
 
 
+def test_she_factor_gradient_matches_finite_differences_of_she_saturation():
+    """The gradient of epsilon in (Fx, Fy, N) matches central differences of she_saturation."""
+    rng = np.random.default_rng(4)
+    fx, fy = rng.normal(0.0, 2e4, (2, 50))
+    n = rng.uniform(1e4, 1.5e5, 50)
+    grad = contact.she_factor_gradient(fx, fy, n, friction=0.3)
+    args = [fx, fy, n]
+    for k in range(3):
+        h = 1e-4 * np.abs(args[k]) + 1e-3         # O(h^2) error ~1e-8, roundoff ~1e-12
+        up = [a + (h if j == k else 0.0) for j, a in enumerate(args)]
+        down = [a - (h if j == k else 0.0) for j, a in enumerate(args)]
+        fd = (contact.she_saturation(up[0], up[1], 0.0, up[2])[3]
+              - contact.she_saturation(down[0], down[1], 0.0, down[2])[3]) / (2 * h)
+        np.testing.assert_allclose(grad[k], fd, rtol=1e-6, atol=1e-15)
+    # Zero without contact or without creep force.
+    zero = contact.she_factor_gradient([1e4, 0.0], [0.0, 0.0], [0.0, 5e4])
+    assert all(not np.any(z) for z in zero)
+
+
 def test_she_saturation_no_contact_and_zero_force():
     """N <= 0 gives zero tangential forces; F = 0 with contact gives epsilon = 1."""
     out = contact.she_saturation([1e4, 0.0], [0.0, 0.0], [10.0, 0.0], [0.0, 5e4])

@@ -133,8 +133,6 @@ GEOMETRY_STEP = 1e-3
 NULL_TOLERANCE = 1e-9
 #: Lateral DOFs of the car (y, roll, yaw of every body), for mode classification.
 LATERAL_DOFS = car_dofs(range(N_BODIES), ['y', 'roll', 'yaw'])
-# Exponents of the Hertz load scaling of f11, f22, f23, f33 (ct.scale_creep_coefficients).
-_LOAD_EXPONENTS = (2.0 / 3.0, 2.0 / 3.0, 1.0, 4.0 / 3.0)
 
 
 @dataclass(frozen=True)
@@ -314,7 +312,7 @@ def contact_matrices(params: CarParameters | None, speed: float, geometry: Linea
     ellipse = ct.hertz_ellipse(p0, r0)
     f11, f22, f23, f33 = (creep_factor * float(f)
                           for f in ct.creep_coefficients(ellipse.a, ellipse.b))
-    n11, _, n23, n33 = _LOAD_EXPONENTS
+    n11, _, n23, n33 = ct.CREEP_LOAD_EXPONENTS
     # Per-contact geometry (column 0 = left, 1 = right wheel).
     col = np.where(cm.side > 0, 0, 1)
     s = cm.side.astype(float)[:, None]

@@ -461,6 +461,10 @@ def creep_coefficients(a: ArrayLike, b: ArrayLike, *, young_modulus: float = YOU
     return shear * ab * c11, shear * ab * c22, shear * ab ** 1.5 * c23, shear * ab ** 2 * c33
 
 
+#: Exponents of the load scaling of f11, f22, f23, f33 at fixed curvatures.
+CREEP_LOAD_EXPONENTS = (2.0 / 3.0, 2.0 / 3.0, 1.0, 4.0 / 3.0)
+
+
 def scale_creep_coefficients(coefficients: tuple[ArrayLike, ArrayLike, ArrayLike, ArrayLike],
                              reference_load: float, load: ArrayLike) -> tuple[
                                  np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
@@ -489,8 +493,8 @@ def scale_creep_coefficients(coefficients: tuple[ArrayLike, ArrayLike, ArrayLike
     _check_positive('reference load', reference_load)
     ratio = np.maximum(np.asarray(load, dtype=float), 0.0) / reference_load
     f11, f22, f23, f33 = (np.asarray(c, dtype=float) for c in coefficients)
-    s23 = ratio ** (2.0 / 3.0)
-    return f11 * s23, f22 * s23, f23 * ratio, f33 * ratio ** (4.0 / 3.0)
+    e11, e22, e23, e33 = CREEP_LOAD_EXPONENTS
+    return f11 * ratio ** e11, f22 * ratio ** e22, f23 * ratio ** e23, f33 * ratio ** e33
 
 
 @dataclass(frozen=True)
@@ -679,6 +683,44 @@ def she_factor_derivative(beta: ArrayLike) -> np.ndarray:
     """
     x = np.maximum(np.asarray(beta, dtype=float), 0.0)
     return np.where(x <= 3.0, -1.0 / 3.0 + 2.0 * x / 27.0, -1.0 / np.maximum(x, 3.0) ** 2)
+
+
+def she_factor_gradient(fx: ArrayLike, fy: ArrayLike, normal: ArrayLike,
+                        friction: float = FRICTION_COEFFICIENT
+                        ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """
+    Return the partial derivatives of the Shen-Hedrick-Elkins factor epsilon.
+
+    epsilon depends on beta = |(Fx, Fy)| / (mu N) only, so
+    d eps / dFx = eps'(beta) Fx / (|F| mu N), likewise for Fy, and
+    d eps / dN = -eps'(beta) beta / N (:func:`she_factor_derivative`).  Where
+    N <= 0 or F = 0 the derivatives are 0 (epsilon is constant there).
+
+    Parameters
+    ----------
+    fx, fy : array_like
+        Linear-theory creep forces (N).
+    normal : array_like
+        Normal contact force N (N).
+    friction : float
+        Friction coefficient mu.
+
+    Returns
+    -------
+    d_fx, d_fy, d_normal : numpy.ndarray
+        Derivatives of epsilon (1/N).
+
+    """
+    fx, fy, n = np.broadcast_arrays(*(np.asarray(v, dtype=float) for v in (fx, fy, normal)))
+    f = np.hypot(fx, fy)
+    limit = friction * n
+    active = (limit > 0.0) & (f > 0.0)
+    f_safe = np.where(active, f, 1.0)
+    limit_safe = np.where(active, limit, 1.0)
+    beta = f / limit_safe
+    slope = np.where(active, she_factor_derivative(beta), 0.0)
+    per_force = slope / (f_safe * limit_safe)
+    return per_force * fx, per_force * fy, -slope * beta / np.where(active, n, 1.0)
 
 
 def she_saturation(fx: ArrayLike, fy: ArrayLike, mz: ArrayLike, normal: ArrayLike,

@@ -399,27 +399,6 @@ class TrainTrackCoupling:
         log.info('static equilibrium: wheel loads %.1f .. %.1f kN', load.min() / 1e3,
                  load.max() / 1e3)
 
-    def _saturation_slope(self, lin_x: np.ndarray, lin_y: np.ndarray, normal: np.ndarray,
-                          d_lin_x: np.ndarray, d_lin_y: np.ndarray,
-                          d_normal: np.ndarray) -> np.ndarray:
-        """
-        Return the derivative of the Shen-Hedrick-Elkins factor along the unknowns.
-
-        beta = |(Fx, Fy)_linear| / (mu N); d eps = eps'(beta) d beta with
-        d beta = (F . dF) / (|F| mu N) - beta dN / N.  Zero without contact.
-        """
-        f = np.hypot(lin_x, lin_y)
-        limit = self.friction * normal
-        active = (limit > 0.0) & (f > 0.0)
-        f_safe = np.where(active, f, 1.0)
-        limit_safe = np.where(active, limit, 1.0)
-        beta = f / limit_safe
-        d_beta = ((lin_x[..., None] * d_lin_x + lin_y[..., None] * d_lin_y)
-                  / (f_safe * limit_safe)[..., None]
-                  - (beta / np.where(active, normal, 1.0))[..., None] * d_normal)
-        slope = np.where(active, ct.she_factor_derivative(beta), 0.0)
-        return slope[..., None] * d_beta
-
     def _check_flange(self, lateral: np.ndarray) -> None:
         """Raise DivergenceError when a wheelset runs beyond the contact-geometry table."""
         if self.table is None:
@@ -542,8 +521,9 @@ class TrainTrackCoupling:
                 d_lin_x = -f11[..., None] * d_xi_x
                 d_lin_y = -f22[..., None] * d_xi_y - f23[..., None] * d_xi_sp
                 d_lin_m = f23[..., None] * d_xi_y - f33[..., None] * d_xi_sp
-                d_eps = self._saturation_slope(lin_x, lin_y, fz, d_lin_x, d_lin_y,
-                                               kh[..., None] * d_delta)
+                e_x, e_y, e_n = ct.she_factor_gradient(lin_x, lin_y, fz, self.friction)
+                d_eps = (e_x[..., None] * d_lin_x + e_y[..., None] * d_lin_y
+                         + (e_n * kh)[..., None] * d_delta)
                 creep_x = eps[..., None] * d_lin_x + lin_x[..., None] * d_eps
                 creep_y = eps[..., None] * d_lin_y + lin_y[..., None] * d_eps
                 creep_m = eps[..., None] * d_lin_m + lin_m[..., None] * d_eps
