@@ -21,13 +21,13 @@ from pathlib import Path
 
 import pytest
 from rosbags.highlevel import AnyReader
+from ttb_sim.config.scenario import key_spec, load_scenario, Scenario
 from ttb_sim.errors import ScenarioError
 from ttb_sim.io.bag import BagRecorder
 from ttb_sim.io.topics import topic_table
-from ttb_sim.node_logic import (ERROR, initial_values, markers, model_markers, OK,
-                                parameter_table, PassageController, SCENARIO_KEYS,
-                                train_markers, validate_changes, validate_parameter)
-from ttb_sim.scenario import key_spec, load_scenario, Scenario
+from ttb_sim.node_logic import (ERROR, initial_values, markers, model_markers, OK, parameter_table,
+                                PassageController, SCENARIO_KEYS, train_markers, validate_changes,
+                                validate_parameter)
 from ttb_sim.sim.frames import Frame
 
 CONTRACT_PARAMETERS = {

@@ -99,8 +99,8 @@ def main(argv: Sequence[str] | None = None) -> int:
 
 
 def _cmd_run(args: argparse.Namespace) -> int:
-    from ttb_sim.runner import default_output, run_to_bag
-    from ttb_sim.scenario import load_scenario
+    from ttb_sim.commands.run import default_output, run_to_bag
+    from ttb_sim.config.scenario import load_scenario
     from ttb_sim.sim.simulation import Simulation
 
     values = []
@@ -143,7 +143,7 @@ def _cmd_run(args: argparse.Namespace) -> int:
 
 
 def _cmd_validate(args: argparse.Namespace) -> int:
-    from ttb_sim.validation.cases import CASES, format_table, run_cases
+    from ttb_sim.validation.cases.registry import CASES, format_table, run_cases
 
     if args.list:
         for case_id, case in CASES.items():
@@ -161,7 +161,7 @@ def _cmd_validate(args: argparse.Namespace) -> int:
 
 
 def _cmd_scenarios(args: argparse.Namespace) -> int:
-    from ttb_sim.scenario import builtin_scenarios, iter_keys, read_yaml
+    from ttb_sim.config.scenario import builtin_scenarios, iter_keys, read_yaml
 
     if args.keys:
         for key, _typ, default, spec in iter_keys():

@@ -19,7 +19,7 @@ Everything the node decides lives here, so that it is tested where ROS 2 is
 absent; :mod:`ttb_sim.simulator_node` only copies values into rclpy objects.
 
 - :func:`parameter_table` derives the node's parameters from the scenario
-  schema (:func:`ttb_sim.scenario.key_spec`), adding a few node-only ones.
+  schema (:func:`ttb_sim.config.scenario.key_spec`), adding a few node-only ones.
 - :func:`validate_parameter` checks one proposed value and returns
   ``(ok, reason)``; the reason names the parameter, the value and what is allowed.
 - :class:`PassageController` owns a :class:`~ttb_sim.sim.simulation.Simulation`,
@@ -45,10 +45,10 @@ import threading
 import time
 from typing import Any, Callable, Iterator, Mapping, Protocol
 
+from ttb_sim.config.scenario import apply_overrides, from_mapping, key_spec, Scenario, Spec
 from ttb_sim.errors import DivergenceError, ScenarioError, TtbSimError
 from ttb_sim.io.bag import STORAGES
 from ttb_sim.io.topics import FRAME_ID
-from ttb_sim.scenario import apply_overrides, from_mapping, key_spec, Scenario, Spec
 from ttb_sim.sim.frames import Frame, Layout
 from ttb_sim.sim.simulation import Simulation
 

@@ -61,14 +61,14 @@ from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPo
 from rosidl_runtime_py.utilities import get_message
 from std_msgs.msg import ColorRGBA, Header
 from std_srvs.srv import SetBool, Trigger
+from ttb_sim.commands.run import default_output
+from ttb_sim.config.scenario import load_scenario
 from ttb_sim.errors import ScenarioError
 from ttb_sim.io.bag import BagRecorder
 from ttb_sim.io.topics import FRAME_ID, topic_table
 from ttb_sim.node_logic import (DEFAULT_SCENARIO, initial_values, markers, MarkerSet,
                                 NodeParameter, parameter_table, PassageController,
                                 validate_changes)
-from ttb_sim.runner import default_output
-from ttb_sim.scenario import load_scenario
 from visualization_msgs.msg import Marker, MarkerArray
 
 STEP_PERIOD = 0.01

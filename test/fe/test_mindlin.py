@@ -39,8 +39,8 @@ import numpy as np
 import pytest
 import scipy.linalg as la
 import scipy.sparse.linalg as sla
-from ttb_sim.fe.mindlin import (element_matrices, MindlinPlate, plate_matrices,
-                                rectangular_mesh, simply_supported_dofs)
+from ttb_sim.fe.mindlin import (element_matrices, MindlinPlate, plate_matrices, rectangular_mesh,
+                                simply_supported_dofs)
 
 STEEL = {'young': 2.1e11, 'poisson': 0.3, 'density': 7800.0}
 MODES = ((1, 1), (1, 2), (2, 1), (2, 2))

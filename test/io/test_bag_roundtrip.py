@@ -23,7 +23,7 @@ import pytest
 from rosbags.highlevel import AnyReader
 from rosbags.typesys import get_typestore, Stores
 from ttb_sim.cli import main
-from ttb_sim.validation.references import Beam, fryba_peak
+from ttb_sim.validation.references.structural import Beam, fryba_peak
 
 ALPHA = 0.45
 

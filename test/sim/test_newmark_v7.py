@@ -22,8 +22,8 @@ drift (relative drift < 1e-6 over 1e4 steps), VALIDATION.md V7.
 import numpy as np
 import pytest
 import scipy.sparse as sp
-from ttb_sim.sim.newmark import Newmark
-from ttb_sim.validation.cases import newmark_energy_drift, newmark_order, newmark_sdof
+from ttb_sim.sim.integrators.newmark import Newmark
+from ttb_sim.validation.cases.registry import newmark_energy_drift, newmark_order, newmark_sdof
 
 
 def test_order_two():

@@ -16,14 +16,14 @@
 V3: sprung mass (quarter car) crossing a simply supported beam.
 
 Reference: independent modal solution (20 modes, scipy DOP853) re-derived in
-``ttb_sim.validation.references``; the Yang & Yau parameters give 2.408 mm and
+``ttb_sim.validation.references.structural``; the Yang & Yau parameters give 2.408 mm and
 0.148 m/s^2 (PHYSICS.md 9.3). Tolerances: 2 % deflection, 5 % acceleration.
 """
 
 import numpy as np
 import pytest
-from ttb_sim.validation.cases import sprung_mass_comparison
-from ttb_sim.validation.references import Beam, QuarterCar, sprung_mass_modal
+from ttb_sim.validation.cases.registry import sprung_mass_comparison
+from ttb_sim.validation.references.structural import Beam, QuarterCar, sprung_mass_modal
 
 
 def test_modal_reference_reproduces_published_values():

@@ -19,13 +19,13 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from ttb_sim.config.scenario import load_scenario
 from ttb_sim.errors import ScenarioError
-from ttb_sim.model import contact as ct
-from ttb_sim.model.car import dof
-from ttb_sim.model.profiles import contact_geometry_table
-from ttb_sim.scenario import load_scenario
+from ttb_sim.model.vehicle.car import dof
+from ttb_sim.model.wheel_rail import contact as ct
+from ttb_sim.model.wheel_rail.profiles import contact_geometry_table
+from ttb_sim.sim.coupling.train_track import car_parameters
 from ttb_sim.sim.simulation import Simulation
-from ttb_sim.sim.ttbi import car_parameters
 
 SMALL = [('train.vehicle', 'car'), ('track.model', 'slab'), ('train.n_cars', 1),
          ('bridge.n_spans', 1), ('bearings.model', 'elastic'), ('train.start_position', 0.0)]

@@ -27,9 +27,9 @@ import math
 import numpy as np
 import pytest
 
-from ttb_sim.model import car
-from ttb_sim.model.spectra import SPECTRA
-from ttb_sim.validation import component_cases as cc
+from ttb_sim.model.irregularity.spectra import SPECTRA
+from ttb_sim.model.vehicle import car
+from ttb_sim.validation.cases import components as cc
 from ttb_sim.validation.rows import Row
 
 TITLES = {

@@ -38,7 +38,7 @@ Tolerances and why
 
 import numpy as np
 import pytest
-from ttb_sim.validation import slab_plate as sp
+from ttb_sim.validation.cases import slab_plate as sp
 
 
 @pytest.fixture(scope='module')

@@ -16,7 +16,7 @@
 Fast versions of the track validation cases V2 and V6 (VALIDATION.md).
 
 Every number comes from pipeline runs of the ``track_approach`` scenario
-(scenario -> Simulation -> frames); see :mod:`ttb_sim.validation.track_cases`
+(scenario -> Simulation -> frames); see :mod:`ttb_sim.validation.cases.track`
 for the reading of the cases and the full-accuracy numbers.
 """
 
@@ -26,9 +26,9 @@ import numpy as np
 import pytest
 
 from ttb_sim.sim.simulation import Simulation
-from ttb_sim.validation import track_cases as tc
-from ttb_sim.validation import track_references as tr
-from ttb_sim.validation.cases import CASES
+from ttb_sim.validation.cases import track as tc
+from ttb_sim.validation.cases.registry import CASES
+from ttb_sim.validation.references import track as tr
 
 #: [P] Table 4 layer stiffness (N/m^2), the flexible slab.
 P_LAYER = 1.5e9

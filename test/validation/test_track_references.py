@@ -30,7 +30,7 @@ import numpy as np
 import pytest
 from scipy.integrate import quad
 from scipy.optimize import brentq
-from ttb_sim.validation import track_references as tr
+from ttb_sim.validation.references import track as tr
 
 EI = 2.059e11 * 3.217e-5
 M = 60.64

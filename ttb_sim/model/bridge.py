@@ -36,10 +36,10 @@ import math
 import numpy as np
 import scipy.sparse as sp
 
+from ttb_sim.config.scenario import Scenario, TrainConfig
 from ttb_sim.fe.assembly import assemble, assemble_links, link_kinematics
 from ttb_sim.fe.beam import BeamSection, global_matrices, NODE_DOFS, vertical_row, W_DOFS
 from ttb_sim.model.track import BeamLine, build_track, TrackMesh
-from ttb_sim.scenario import Scenario, TrainConfig
 
 
 def train_length(train: TrainConfig) -> float:

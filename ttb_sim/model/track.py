@@ -40,9 +40,9 @@ import math
 
 import numpy as np
 
+from ttb_sim.config.scenario import TrackConfig
 from ttb_sim.fe.assembly import link_kinematics
 from ttb_sim.fe.beam import BeamSection, field_rows, NODE_DOFS, offset_rows, point_rows
-from ttb_sim.scenario import TrackConfig
 
 POISSON_CONCRETE = 0.2
 STEEL_DENSITY = 7850.0

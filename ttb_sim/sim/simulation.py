@@ -27,15 +27,15 @@ from typing import Iterator
 
 import numpy as np
 
+from ttb_sim.config.scenario import parse_observers, Scenario
 from ttb_sim.errors import DivergenceError, ScenarioError
 from ttb_sim.model.bridge import bearing_forces, build_structure, Structure
-from ttb_sim.model.irregularity import load_csv, synthesize, TrackIrregularity
-from ttb_sim.model.vehicle import build_vehicle, MovingForces, MultibodyCars, QuarterCars
-from ttb_sim.scenario import parse_observers, Scenario
+from ttb_sim.model.irregularity.profile import load_csv, synthesize, TrackIrregularity
+from ttb_sim.model.vehicle.train import build_vehicle, MovingForces, MultibodyCars, QuarterCars
+from ttb_sim.sim.coupling.quarter_car import QuarterCarCoupling
+from ttb_sim.sim.coupling.train_track import TrainTrackCoupling
 from ttb_sim.sim.frames import Frame, Layout
-from ttb_sim.sim.newmark import Newmark
-from ttb_sim.sim.ttbi import TrainTrackCoupling
-from ttb_sim.sim.vbi import QuarterCarCoupling
+from ttb_sim.sim.integrators.newmark import Newmark
 
 log = logging.getLogger(__name__)
 
@@ -297,7 +297,7 @@ class Simulation:
                 'or is not finite; try a smaller solver.dt')
 
     def _car_frames(self) -> Iterator[Frame]:
-        """Step multibody cars on the slab track (see :mod:`ttb_sim.sim.ttbi`)."""
+        """Step multibody cars on the slab track (see :mod:`ttb_sim.sim.coupling.train_track`)."""
         tt, dt = self.train_track, self.dt
         head = self.scenario.train.start_position
         tt.equilibrium(head)

@@ -17,9 +17,8 @@
 from pathlib import Path
 
 import pytest
+from ttb_sim.config.scenario import builtin_scenarios, iter_keys, key_spec, load_scenario, Scenario
 from ttb_sim.errors import ScenarioError
-from ttb_sim.scenario import (builtin_scenarios, iter_keys, key_spec, load_scenario,
-                              Scenario)
 
 CONTRACT_KEYS = ('bridge.span_length', 'bridge.bending_stiffness', 'bridge.mass_per_length',
                  'bridge.damping_ratio', 'train.speed_kmh', 'train.axle_load',

@@ -18,7 +18,7 @@ Tests of the track irregularity spectra (PHYSICS.md 1.1-1.4, VALIDATION.md V10).
 The reference spectra below are typed again from PHYSICS.md in their SOURCE
 units (mm^2/(1/m), m^2/(rad/m), cm^2/(rad/m), rad^2/(rad/m)); the conversion
 to the one-sided G(n) in m^2/(cycle/m) is written out here independently of
-``ttb_sim.model.spectra``.
+``ttb_sim.model.irregularity.spectra``.
 """
 
 from __future__ import annotations
@@ -30,7 +30,7 @@ import pytest
 from scipy import integrate
 
 from ttb_sim.errors import ScenarioError
-from ttb_sim.model import spectra
+from ttb_sim.model.irregularity import spectra
 
 TWO_PI = 2.0 * math.pi
 HALF_SPACING = 0.75          # b (m), PHYSICS.md 1.3

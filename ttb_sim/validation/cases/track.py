@@ -20,7 +20,7 @@ as 3-D Euler beams, two elements per 0.63 m bay, on discrete fasteners on unit
 slabs; the car stays on the approach, where the base plate rests on rigid
 ground) through :class:`~ttb_sim.sim.simulation.Simulation` and read the
 frames: rail observers (``output.observers``) for V2, wheel-rail forces for V6.
-The references are the closed forms of :mod:`ttb_sim.validation.track_references`
+The references are the closed forms of :mod:`ttb_sim.validation.references.track`
 (an infinite Euler beam on the smeared fasteners, k = k_v / s = 7.94e7 N/m^2,
 c = c_v / s), which share no code with the pipeline.
 
@@ -113,11 +113,11 @@ from scipy.linalg import eigh
 from scipy.optimize import minimize_scalar
 
 from ttb_sim.analysis.psd import peak_frequency
+from ttb_sim.config.scenario import load_scenario, Scenario
 from ttb_sim.model.track import approach_length
-from ttb_sim.scenario import load_scenario, Scenario
+from ttb_sim.sim.coupling.train_track import car_parameters
 from ttb_sim.sim.simulation import Simulation
-from ttb_sim.sim.ttbi import car_parameters
-from ttb_sim.validation import track_references as tr
+from ttb_sim.validation.references import track as tr
 from ttb_sim.validation.rows import Case, relative_row, Row
 
 log = logging.getLogger(__name__)
@@ -196,7 +196,7 @@ def superposed_peak(offsets: np.ndarray, load: float, speed: float,
 
     The loads sit at ``-offsets`` from a reference point moving at ``speed``;
     the deflection at a fixed point is the sum of
-    :func:`~ttb_sim.validation.track_references.moving_load_deflection` over
+    :func:`~ttb_sim.validation.references.track.moving_load_deflection` over
     the loads, maximised over the reference position (grid, then a bounded
     scalar search).
     """

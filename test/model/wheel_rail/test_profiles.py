@@ -15,7 +15,7 @@
 """
 Tests of the parametric LMA-type / CHN60-type profiles and the contact-geometry table.
 
-The profiles are approximations (see ttb_sim.model.profiles); the tests check
+The profiles are approximations (see ttb_sim.model.wheel_rail.profiles); the tests check
 geometric consistency and plausibility, with the measured numbers recorded.
 """
 
@@ -27,7 +27,7 @@ import numpy as np
 import pytest
 
 from ttb_sim.errors import ScenarioError
-from ttb_sim.model import contact, profiles
+from ttb_sim.model.wheel_rail import contact, profiles
 
 
 @pytest.fixture(scope='module')

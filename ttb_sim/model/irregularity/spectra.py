@@ -41,7 +41,7 @@ Components are named ``vertical`` (mean vertical profile of the two rails),
 ``alignment`` (mean lateral position), ``cross_level`` (height of the left rail
 minus height of the right rail, m) and ``gauge`` (gauge widening, m).  How the
 four are combined into rail irregularities is defined in
-:mod:`ttb_sim.model.irregularity`.
+:mod:`ttb_sim.model.irregularity.profile`.
 
 Each component has a default wavelength band (its range of validity, or the
 band used by the source).  ``psd`` is nevertheless defined for every n > 0 so
@@ -418,7 +418,7 @@ def sato_spectrum(
     Source form S(Omega) = A / Omega^3 (m^2/(rad/m), one-sided, Omega in rad/m),
     so that G(n) = 2 pi S(2 pi n) = A / (4 pi^2 n^3).  It has a ``vertical``
     component only; the synthesis adds it to the mean vertical profile, i.e.
-    identically to both rails (see :mod:`ttb_sim.model.irregularity`).
+    identically to both rails (see :mod:`ttb_sim.model.irregularity.profile`).
 
     Parameters
     ----------

@@ -26,7 +26,8 @@ import numpy as np
 import pytest
 
 from ttb_sim.errors import ScenarioError
-from ttb_sim.model import car, contact
+from ttb_sim.model.vehicle import car
+from ttb_sim.model.wheel_rail import contact
 
 P0 = (48000 / 8 + 3200 / 4 + 2400 / 2) * 9.81     # 78.48 kN, PHYSICS.md 2.1
 

@@ -31,8 +31,7 @@ import pytest
 from scipy import integrate, signal
 
 from ttb_sim.errors import ScenarioError
-from ttb_sim.model import irregularity as irr
-from ttb_sim.model import spectra
+from ttb_sim.model.irregularity import profile as irr, spectra
 
 ALL_COMPONENTS = [(f, c) for f, fam in spectra.SPECTRA.items() for c in fam.components]
 RAILS = irr.RAIL_QUANTITIES

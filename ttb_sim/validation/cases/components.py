@@ -16,9 +16,9 @@
 Component validation cases V4, V5, V8, V9 and V10 (VALIDATION.md).
 
 Every number comes from the package code a simulation uses: the car matrices
-and their eigen-analysis (:mod:`ttb_sim.model.car`), the Hertz contact law
-(:mod:`ttb_sim.model.contact`) and the irregularity synthesis
-(:mod:`ttb_sim.model.irregularity`, :mod:`ttb_sim.model.spectra`).  Only the
+and their eigen-analysis (:mod:`ttb_sim.model.vehicle.car`), the Hertz contact law
+(:mod:`ttb_sim.model.wheel_rail.contact`) and the irregularity synthesis
+(:mod:`ttb_sim.model.irregularity.profile`, :mod:`ttb_sim.model.irregularity.spectra`).  Only the
 post-processing (naming modes by their shape, Welch PSD per octave band) is
 written here.
 
@@ -44,10 +44,11 @@ import math
 import numpy as np
 from scipy import signal
 
-from ttb_sim.model import car
-from ttb_sim.model.contact import hertz_constant, linearised_stiffness, static_compression
-from ttb_sim.model.irregularity import check_variance, synthesize, VarianceCheck
-from ttb_sim.model.spectra import SPECTRA
+from ttb_sim.model.irregularity.profile import check_variance, synthesize, VarianceCheck
+from ttb_sim.model.irregularity.spectra import SPECTRA
+from ttb_sim.model.vehicle import car
+from ttb_sim.model.wheel_rail.contact import (hertz_constant, linearised_stiffness,
+                                              static_compression)
 from ttb_sim.validation.rows import Case, relative_row, Row
 
 #: Car body and bogies: the bodies left free in V4 (wheelsets held).
@@ -86,7 +87,7 @@ def vertical_modes(params: car.CarParameters | None = None) -> dict[str, list[fl
     Return the vertical modes of car body and bogies, wheelsets held, named by shape.
 
     The z and pitch DOFs of the car body and both bogies are kept free
-    (:func:`ttb_sim.model.car.eigenfrequencies`); every mode is named after
+    (:func:`ttb_sim.model.vehicle.car.eigenfrequencies`); every mode is named after
     the DOF group (car-body bounce, car-body pitch, bogie bounce, bogie
     pitch) holding more than ``MODE_SHARE`` of its kinetic energy.
 
@@ -193,7 +194,7 @@ def _label(family: str, component: str, n_components: int) -> str:
 
 def variance_checks(seeds: int = ENSEMBLE_SEEDS) -> dict[str, list[VarianceCheck]]:
     """
-    Run :func:`ttb_sim.model.irregularity.check_variance` on every component.
+    Run :func:`ttb_sim.model.irregularity.profile.check_variance` on every component.
 
     Parameters
     ----------

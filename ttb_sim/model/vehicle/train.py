@@ -27,7 +27,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from ttb_sim.scenario import G, TrainConfig
+from ttb_sim.config.scenario import G, TrainConfig
 
 
 @dataclass(frozen=True)
@@ -79,10 +79,10 @@ class QuarterCars:
 @dataclass(frozen=True)
 class MultibodyCars:
     """
-    A train of 42-DOF cars (:mod:`ttb_sim.model.car`) on wheel-rail contact.
+    A train of 42-DOF cars (:mod:`ttb_sim.model.vehicle.car`) on wheel-rail contact.
 
     Only the axle layout lives here; the matrices and the contact state belong
-    to :class:`ttb_sim.sim.ttbi.TrainTrackCoupling`.
+    to :class:`ttb_sim.sim.coupling.train_track.TrainTrackCoupling`.
     """
 
     axles: Axles

@@ -81,8 +81,8 @@ from scipy import fft
 from scipy.interpolate import CubicSpline
 
 from ttb_sim.errors import ScenarioError
-from ttb_sim.model.spectra import (
-    COMPONENTS, get_spectrum, SPECTRA, SpectrumComponent, SpectrumFamily)
+from ttb_sim.model.irregularity.spectra import (COMPONENTS, get_spectrum, SPECTRA,
+                                                SpectrumComponent, SpectrumFamily)
 
 __all__ = [
     'CSV_COLUMNS',

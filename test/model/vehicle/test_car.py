@@ -27,8 +27,8 @@ import numpy as np
 import pytest
 
 from ttb_sim.errors import ScenarioError
-from ttb_sim.model import car
-from ttb_sim.model.contact import hertz_constant, linearised_stiffness
+from ttb_sim.model.vehicle import car
+from ttb_sim.model.wheel_rail.contact import hertz_constant, linearised_stiffness
 
 UPPER = ('car_body', 'bogie_1', 'bogie_2')
 G = 9.81

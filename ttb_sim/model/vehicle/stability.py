@@ -15,16 +15,16 @@
 """
 Linear lateral stability (hunting) of one multibody car on rigid, straight, smooth track.
 
-The car of :mod:`ttb_sim.model.car` is linearised at speed V about the
+The car of :mod:`ttb_sim.model.vehicle.car` is linearised at speed V about the
 centred static state (every wheelset at y = 0, every wheel load P0):
 
     M q'' + (C + G(V) + C_c(V)) q' + (K + K_c) q = 0
 
 M, C, K are the suspension matrices of the car, G(V) its wheelset
-gyroscopic matrix (:func:`ttb_sim.model.car.gyroscopic_matrix`) and C_c, K_c
+gyroscopic matrix (:func:`ttb_sim.model.vehicle.car.gyroscopic_matrix`) and C_c, K_c
 the linearised wheel-rail contact of :func:`contact_matrices`.  The contact
 laws are those of the time-domain solver
-(:meth:`ttb_sim.sim.ttbi.TrainTrackCoupling.step`) with the rails held
+(:meth:`ttb_sim.sim.coupling.train_track.TrainTrackCoupling.step`) with the rails held
 fixed, so this is an independent check of that implementation:
 
 * Hertz: Fz = ((rail_z - wheel_z + height(y)) / G)^(3/2), linearised to
@@ -101,11 +101,11 @@ import scipy.linalg
 from scipy.optimize import brentq
 
 from ttb_sim.errors import ScenarioError
-from ttb_sim.model import contact as ct
-from ttb_sim.model.car import (CarParameters, contact_map, damping_matrix, DOF_PER_BODY,
-                               dofs as car_dofs, gyroscopic_matrix, mass_matrix, N_BODIES,
-                               N_DOF, stiffness_matrix, WHEELSETS)
-from ttb_sim.model.profiles import contact_geometry_table, ContactGeometryTable
+from ttb_sim.model.vehicle.car import (CarParameters, contact_map, damping_matrix, DOF_PER_BODY,
+                                       dofs as car_dofs, gyroscopic_matrix, mass_matrix, N_BODIES,
+                                       N_DOF, stiffness_matrix, WHEELSETS)
+from ttb_sim.model.wheel_rail import contact as ct
+from ttb_sim.model.wheel_rail.profiles import contact_geometry_table, ContactGeometryTable
 
 log = logging.getLogger(__name__)
 
@@ -259,7 +259,7 @@ def contact_matrices(params: CarParameters | None, speed: float, geometry: Linea
     Return the linearised contact damping C_c and stiffness K_c (42 x 42) on rigid rails.
 
     Per contact k (side s, wheelset lateral DOF y_k = S_k q, maps hx, hy, hz,
-    hyaw of :class:`ttb_sim.model.car.ContactMap`) the force perturbations are
+    hyaw of :class:`ttb_sim.model.vehicle.car.ContactMap`) the force perturbations are
 
     * normal: dFz = Z q with Z = k_H (height' S - hz) (Hertz tangent at P0);
     * longitudinal: dFx = -f11 (hx q' / V - r' / r0 S q)

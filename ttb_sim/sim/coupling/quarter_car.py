@@ -29,10 +29,10 @@ from __future__ import annotations
 
 import numpy as np
 
+from ttb_sim.config.scenario import G
 from ttb_sim.model.bridge import GirderLine
-from ttb_sim.model.vehicle import QuarterCars
-from ttb_sim.scenario import G
-from ttb_sim.sim.newmark import Newmark
+from ttb_sim.model.vehicle.train import QuarterCars
+from ttb_sim.sim.integrators.newmark import Newmark
 
 
 class QuarterCarCoupling:

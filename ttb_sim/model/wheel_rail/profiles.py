@@ -69,7 +69,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from ttb_sim.errors import ScenarioError
-from ttb_sim.model.contact import WheelsetGeometry
+from ttb_sim.model.wheel_rail.contact import WheelsetGeometry
 
 
 @dataclass(frozen=True)
@@ -499,7 +499,7 @@ class ContactGeometryTable:
         Returns
         -------
         WheelsetGeometry
-            For :func:`ttb_sim.model.contact.creepages`.
+            For :func:`ttb_sim.model.wheel_rail.contact.creepages`.
 
         """
         return WheelsetGeometry(rolling_radius=self._interp(y, self.rolling_radius),

@@ -55,16 +55,17 @@ import math
 import numpy as np
 import scipy.sparse.linalg as sla
 
+from ttb_sim.config.scenario import Scenario
 from ttb_sim.errors import DivergenceError
 from ttb_sim.fe.beam import point_rows
-from ttb_sim.model import contact as ct
 from ttb_sim.model.bridge import Structure
-from ttb_sim.model.car import CarParameters, dofs as car_dofs, gyroscopic_matrix, train_matrices
-from ttb_sim.model.irregularity import TrackIrregularity
-from ttb_sim.model.profiles import contact_geometry_table
+from ttb_sim.model.irregularity.profile import TrackIrregularity
 from ttb_sim.model.track import BeamLine
-from ttb_sim.scenario import Scenario
-from ttb_sim.sim.newmark import Newmark
+from ttb_sim.model.vehicle.car import (CarParameters, dofs as car_dofs, gyroscopic_matrix,
+                                       train_matrices)
+from ttb_sim.model.wheel_rail import contact as ct
+from ttb_sim.model.wheel_rail.profiles import contact_geometry_table
+from ttb_sim.sim.integrators.newmark import Newmark
 
 log = logging.getLogger(__name__)
 

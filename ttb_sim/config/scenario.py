@@ -731,7 +731,7 @@ def read_yaml(text: str) -> Any:
 
 def config_dirs() -> list[Path]:
     """Return the folders searched for built-in scenarios, in order."""
-    dirs = [Path(__file__).resolve().parent.parent / 'config']
+    dirs = [Path(__file__).resolve().parents[2] / 'config']
     for scheme_key in ('data',):
         base = sysconfig.get_paths().get(scheme_key)
         if base:

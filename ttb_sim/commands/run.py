@@ -30,10 +30,10 @@ import time
 from typing import Any, Callable
 
 from ttb_sim import __version__
+from ttb_sim.config.scenario import Scenario
 from ttb_sim.errors import DivergenceError
 from ttb_sim.io.bag import BagRecorder, check_destination
 from ttb_sim.io.topics import PeakTracker, topic_table
-from ttb_sim.scenario import Scenario
 from ttb_sim.sim.simulation import Simulation
 
 log = logging.getLogger(__name__)

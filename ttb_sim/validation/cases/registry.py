@@ -16,7 +16,7 @@
 The validation suite behind ``ttb-sim validate`` (VALIDATION.md).
 
 Every case runs the user pipeline (built-in scenario -> Simulation -> frames)
-and compares with an independent reference from :mod:`ttb_sim.validation.references`.
+and compares with an independent reference from :mod:`ttb_sim.validation.references.structural`.
 """
 
 from __future__ import annotations
@@ -27,16 +27,16 @@ from typing import Sequence
 import numpy as np
 import scipy.sparse as sp
 
-from ttb_sim.scenario import load_scenario, Scenario
-from ttb_sim.sim.newmark import Newmark
+from ttb_sim.config.scenario import load_scenario, Scenario
+from ttb_sim.sim.integrators.newmark import Newmark
 from ttb_sim.sim.simulation import Simulation
-from ttb_sim.validation.component_cases import COMPONENT_CASES
-from ttb_sim.validation.references import (Beam, fryba_peak, QuarterCar,
-                                           sprung_mass_modal)
+from ttb_sim.validation.cases.components import COMPONENT_CASES
+from ttb_sim.validation.cases.slab_plate import SLAB_PLATE_CASES
+from ttb_sim.validation.cases.system import SYSTEM_CASES
+from ttb_sim.validation.cases.track import TRACK_CASES
+from ttb_sim.validation.references.structural import (Beam, fryba_peak, QuarterCar,
+                                                      sprung_mass_modal)
 from ttb_sim.validation.rows import Case, relative_row, Row
-from ttb_sim.validation.slab_plate import SLAB_PLATE_CASES
-from ttb_sim.validation.system_cases import SYSTEM_CASES
-from ttb_sim.validation.track_cases import TRACK_CASES
 
 V1_ALPHAS = (0.1, 0.3, 0.5, 0.62, 1.0)
 
