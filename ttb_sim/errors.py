@@ -23,6 +23,16 @@ class ScenarioError(TtbSimError, ValueError):
     """A scenario, argument or input file is invalid (CLI exit code 2)."""
 
 
+class ModelError(TtbSimError, ValueError):
+    """
+    A physical argument given to the model layer is invalid (CLI exit code 2).
+
+    Raised by ``model/`` and ``fe/`` code, which knows arguments but not scenario
+    keys; the configuration layer re-raises it as :class:`ScenarioError` naming
+    the key path.
+    """
+
+
 class SimulationError(TtbSimError, RuntimeError):
     """The simulation could not be carried out (CLI exit code 1)."""
 
