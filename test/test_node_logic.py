@@ -21,7 +21,7 @@ from pathlib import Path
 
 import pytest
 from rosbags.highlevel import AnyReader
-from ttb_sim.config.scenario import key_spec, load_scenario, Scenario
+from ttb_sim.config import key_spec, load_scenario, Scenario
 from ttb_sim.errors import ScenarioError
 from ttb_sim.io.bag import BagRecorder
 from ttb_sim.io.topics import topic_table

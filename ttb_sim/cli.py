@@ -13,7 +13,10 @@
 # limitations under the License.
 
 """
-The ``ttb-sim`` command: run, validate and list scenarios without ROS.
+The ``ttb-sim`` command line: argument parsing and the mapping of errors to exit codes.
+
+The verbs themselves live in :mod:`ttb_sim.commands` (ROS-free, callable from
+tests and the node).
 
 Exit codes: 0 success; 1 numerical failure (divergence) or failed validation;
 2 bad scenario or argument; 130 / 143 interrupted by SIGINT / SIGTERM.
@@ -24,29 +27,15 @@ from __future__ import annotations
 import argparse
 import logging
 from pathlib import Path
-import signal
 import sys
 from typing import Sequence
 
 from ttb_sim import __version__
-from ttb_sim.errors import ScenarioError, TtbSimError
+from ttb_sim.errors import ModelError, ScenarioError, TtbSimError
 
 log = logging.getLogger('ttb_sim')
 
 EXIT_OK, EXIT_FAILURE, EXIT_USAGE = 0, 1, 2
-
-
-class _StopFlag:
-    """Signal handler that records SIGINT / SIGTERM for the run loop to poll."""
-
-    def __init__(self) -> None:
-        self.signal: int | None = None
-
-    def __call__(self, signum: int, frame: object) -> None:
-        self.signal = signum
-
-    def __bool__(self) -> bool:
-        return self.signal is not None
 
 
 def _parser() -> argparse.ArgumentParser:
@@ -86,97 +75,21 @@ def main(argv: Sequence[str] | None = None) -> int:
                         format='%(levelname)s %(name)s: %(message)s')
     try:
         if args.command == 'run':
-            return _cmd_run(args)
+            from ttb_sim.commands.run import run
+            return run(args.scenario, out=args.out, storage=args.storage,
+                       overrides=args.overrides, speed_kmh=args.speed_kmh,
+                       duration=args.duration)
         if args.command == 'validate':
-            return _cmd_validate(args)
-        return _cmd_scenarios(args)
-    except ScenarioError as exc:
+            from ttb_sim.commands.validate import validate
+            return validate(args.cases, list_only=args.list)
+        from ttb_sim.commands.scenarios import scenarios
+        return scenarios(keys=args.keys)
+    except (ScenarioError, ModelError) as exc:
         print(f'ttb-sim: error: {exc}', file=sys.stderr)
         return EXIT_USAGE
     except TtbSimError as exc:
         print(f'ttb-sim: failed: {exc}', file=sys.stderr)
         return EXIT_FAILURE
-
-
-def _cmd_run(args: argparse.Namespace) -> int:
-    from ttb_sim.commands.run import default_output, run_to_bag
-    from ttb_sim.config.scenario import load_scenario
-    from ttb_sim.sim.simulation import Simulation
-
-    values = []
-    if args.speed_kmh is not None:
-        values.append(('train.speed_kmh', args.speed_kmh))
-    if args.duration is not None:
-        values.append(('solver.duration', args.duration))
-    scenario = load_scenario(args.scenario, args.overrides, values)
-    simulation = Simulation(scenario)
-    out = args.out if args.out is not None else default_output(scenario.name)
-    bar = None
-    if sys.stderr.isatty():
-        from tqdm import tqdm
-        bar = tqdm(total=simulation.n_frames, unit='frame', desc=scenario.name,
-                   file=sys.stderr, leave=False)
-    stop = _StopFlag()
-    previous = {sig: signal.signal(sig, stop) for sig in (signal.SIGINT, signal.SIGTERM)}
-    try:
-        result = run_to_bag(scenario, out, args.storage,
-                            progress=bar.update if bar is not None else None,
-                            simulation=simulation, should_stop=stop.__bool__)
-    finally:
-        for sig, handler in previous.items():
-            signal.signal(sig, handler)
-        if bar is not None:
-            bar.close()
-    s = result.summary
-    if result.status == 'interrupted':
-        name = signal.Signals(stop.signal).name if stop.signal else 'signal'
-        print(f'ttb-sim: stopped by {name}; bag closed at {out} with {s["frames"]} frames',
-              file=sys.stderr)
-        return 128 + (stop.signal or signal.SIGINT)
-    if result.status == 'diverged':
-        print(f'ttb-sim: failed: {s["message"]}; bag closed at {out} with {s["frames"]} '
-              'frames', file=sys.stderr)
-        return EXIT_FAILURE
-    print(f'{out}: {s["frames"]} frames, {s["simulated_time"]:.3f} s simulated in '
-          f'{s["wall_time"]:.2f} s (real-time factor {s["real_time_factor"]:.3g})')
-    return EXIT_OK
-
-
-def _cmd_validate(args: argparse.Namespace) -> int:
-    from ttb_sim.validation.cases.registry import CASES, format_table, run_cases
-
-    if args.list:
-        for case_id, case in CASES.items():
-            print(f'{case_id:5s} {case.title}')
-        return EXIT_OK
-    unknown = [c for c in args.cases if c not in CASES]
-    if unknown:
-        raise ScenarioError(f'unknown validation case(s) {", ".join(unknown)}; allowed: '
-                            f'{", ".join(CASES)}')
-    rows = run_cases(args.cases or list(CASES))
-    print(format_table(rows))
-    failed = sum(not r.passed for r in rows)
-    print(f'{len(rows) - failed} passed, {failed} failed')
-    return EXIT_OK if failed == 0 else EXIT_FAILURE
-
-
-def _cmd_scenarios(args: argparse.Namespace) -> int:
-    from ttb_sim.config.scenario import builtin_scenarios, iter_keys, read_yaml
-
-    if args.keys:
-        for key, _typ, default, spec in iter_keys():
-            dyn = ' (dynamic)' if spec.dynamic else ''
-            print(f'{key:34s} {spec.unit:9s} default {default!r:14} {spec.allowed()}{dyn}\n'
-                  f'{"":34s} {spec.description}')
-        return EXIT_OK
-    for name, path in builtin_scenarios().items():
-        try:
-            description = (read_yaml(path.read_text(encoding='utf-8')) or {}).get(
-                'description', '')
-        except Exception:  # noqa: B902 - listing must not fail on one bad file
-            description = '(unreadable)'
-        print(f'{name:22s} {description}')
-    return EXIT_OK
 
 
 if __name__ == '__main__':  # pragma: no cover

@@ -45,7 +45,7 @@ import threading
 import time
 from typing import Any, Callable, Iterator, Mapping, Protocol
 
-from ttb_sim.config.scenario import apply_overrides, from_mapping, key_spec, Scenario, Spec
+from ttb_sim.config import apply_overrides, from_mapping, key_spec, Scenario, Spec
 from ttb_sim.errors import DivergenceError, ScenarioError, TtbSimError
 from ttb_sim.io.bag import STORAGES
 from ttb_sim.io.topics import FRAME_ID
@@ -883,7 +883,7 @@ def train_markers(scenario: Scenario, head_position: float) -> list[Box]:
 
     """
     t = scenario.train
-    offsets = t.axle_positions()
+    offsets = scenario.axle_positions()
     boxes = [Box('axles', i, (head_position - a, 0.0, 0.5), (1.0, 1.5, 1.0), AXLE_COLOR)
              for i, a in enumerate(offsets)]
     if not t.axle_offsets:

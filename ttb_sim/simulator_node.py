@@ -62,7 +62,7 @@ from rosidl_runtime_py.utilities import get_message
 from std_msgs.msg import ColorRGBA, Header
 from std_srvs.srv import SetBool, Trigger
 from ttb_sim.commands.run import default_output
-from ttb_sim.config.scenario import load_scenario
+from ttb_sim.config import load_scenario
 from ttb_sim.errors import ScenarioError
 from ttb_sim.io.bag import BagRecorder
 from ttb_sim.io.topics import FRAME_ID, topic_table

@@ -17,7 +17,7 @@
 from pathlib import Path
 
 import pytest
-from ttb_sim.config.scenario import builtin_scenarios, iter_keys, key_spec, load_scenario, Scenario
+from ttb_sim.config import builtin_scenarios, iter_keys, key_spec, load_scenario, Scenario
 from ttb_sim.errors import ScenarioError
 
 CONTRACT_KEYS = ('bridge.span_length', 'bridge.bending_stiffness', 'bridge.mass_per_length',
@@ -94,7 +94,7 @@ def test_unreadable_and_missing_files(tmp_path: Path):
 
 def test_axle_layout_from_car_geometry():
     s = load_scenario('moving_force_beam', ['train.axle_offsets=[]', 'train.n_cars=2'])
-    axles = s.train.axle_positions()
+    axles = s.axle_positions()
     assert len(axles) == 8
     # Wheelbase 2 l_t, bogie centres 2 l_c apart, cars 25 m apart.
     assert axles[1] - axles[0] == pytest.approx(2.5)

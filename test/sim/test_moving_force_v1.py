@@ -22,7 +22,7 @@ user pipeline (built-in scenario -> Simulation -> frames), default time step.
 
 import numpy as np
 import pytest
-from ttb_sim.config.scenario import load_scenario
+from ttb_sim.config import load_scenario
 from ttb_sim.sim.simulation import Simulation
 from ttb_sim.validation.cases.registry import moving_force_daf
 from ttb_sim.validation.references.structural import Beam, fryba_peak

@@ -19,12 +19,11 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from ttb_sim.config.scenario import load_scenario
+from ttb_sim.config import load_scenario
 from ttb_sim.errors import ScenarioError
 from ttb_sim.model.vehicle.car import dof
 from ttb_sim.model.wheel_rail import contact as ct
 from ttb_sim.model.wheel_rail.profiles import contact_geometry_table
-from ttb_sim.sim.coupling.train_track import car_parameters
 from ttb_sim.sim.simulation import Simulation
 
 SMALL = [('train.vehicle', 'car'), ('track.model', 'slab'), ('train.n_cars', 1),
@@ -45,7 +44,7 @@ def smooth_run() -> tuple[Simulation, list]:
 
 def test_static_start_carries_the_static_wheel_load(smooth_run):
     sim, frames = smooth_run
-    p0 = car_parameters(sim.scenario).static_wheel_load
+    p0 = sim.scenario.car.static_wheel_load
     first = frames[0].wheel_rail[0, :, :, 2]
     np.testing.assert_allclose(first, p0, rtol=1e-4)
     # No start-up transient: the car body hardly moves in the first 0.1 s, and the
@@ -85,7 +84,7 @@ def test_static_equilibrium_satisfies_hertz():
 
 def test_mean_vertical_force_is_the_static_load_and_lateral_balances(smooth_run):
     sim, frames = smooth_run
-    p0 = car_parameters(sim.scenario).static_wheel_load
+    p0 = sim.scenario.car.static_wheel_load
     wr = np.array([f.wheel_rail[0] for f in frames])           # (t, axle, side, xyz)
     mean_z = wr[..., 2].mean(axis=0)
     np.testing.assert_allclose(mean_z, p0, rtol=0.005)

@@ -13,7 +13,7 @@
 # limitations under the License.
 
 """
-Offline runs: a scenario simulated to a rosbag2 directory plus ``summary.json``.
+The ``run`` verb: a scenario simulated to a rosbag2 directory plus ``summary.json``.
 
 This is the library behind ``ttb-sim run``: it validates everything before it
 creates anything, writes frames as they come, and leaves a closed, readable bag
@@ -26,17 +26,34 @@ from dataclasses import dataclass
 import json
 import logging
 from pathlib import Path
+import signal
+import sys
 import time
-from typing import Any, Callable
+from typing import Any, Callable, Sequence
 
 from ttb_sim import __version__
-from ttb_sim.config.scenario import Scenario
+from ttb_sim.config import load_scenario, Scenario
 from ttb_sim.errors import DivergenceError
 from ttb_sim.io.bag import BagRecorder, check_destination
 from ttb_sim.io.topics import PeakTracker, topic_table
 from ttb_sim.sim.simulation import Simulation
 
 log = logging.getLogger(__name__)
+
+EXIT_OK, EXIT_FAILURE = 0, 1
+
+
+class StopFlag:
+    """Signal handler that records SIGINT / SIGTERM for the run loop to poll."""
+
+    def __init__(self) -> None:
+        self.signal: int | None = None
+
+    def __call__(self, signum: int, frame: object) -> None:
+        self.signal = signum
+
+    def __bool__(self) -> bool:
+        return self.signal is not None
 
 
 @dataclass
@@ -143,3 +160,67 @@ def run_to_bag(scenario: Scenario, out: Path, storage: str = 'mcap',
             (out / 'summary.json').write_text(json.dumps(summary, indent=2) + '\n',
                                               encoding='utf-8')
     return RunResult(path=out, status=status, summary=summary)
+
+
+def run(scenario: str | Path, *, out: Path | None = None, storage: str = 'mcap',
+        overrides: Sequence[str] = (), speed_kmh: float | None = None,
+        duration: float | None = None) -> int:
+    """
+    Run ``ttb-sim run``: load, build, simulate to a bag; return the exit code.
+
+    Parameters
+    ----------
+    scenario
+        YAML path or built-in name.
+    out
+        Bag directory to create (default: a new folder under ``./runs/``).
+    storage
+        'mcap' or 'sqlite3'.
+    overrides
+        ``KEY=VALUE`` strings (YAML scalars).
+    speed_kmh, duration
+        Shortcuts for ``train.speed_kmh`` and ``solver.duration``.
+
+    Raises
+    ------
+    ScenarioError
+        Before anything is written, for a bad scenario or destination.
+
+    """
+    values = []
+    if speed_kmh is not None:
+        values.append(('train.speed_kmh', speed_kmh))
+    if duration is not None:
+        values.append(('solver.duration', duration))
+    loaded = load_scenario(scenario, overrides, values)
+    simulation = Simulation(loaded)
+    out = out if out is not None else default_output(loaded.name)
+    bar = None
+    if sys.stderr.isatty():
+        from tqdm import tqdm
+        bar = tqdm(total=simulation.n_frames, unit='frame', desc=loaded.name,
+                   file=sys.stderr, leave=False)
+    stop = StopFlag()
+    previous = {sig: signal.signal(sig, stop) for sig in (signal.SIGINT, signal.SIGTERM)}
+    try:
+        result = run_to_bag(loaded, out, storage,
+                            progress=bar.update if bar is not None else None,
+                            simulation=simulation, should_stop=stop.__bool__)
+    finally:
+        for sig, handler in previous.items():
+            signal.signal(sig, handler)
+        if bar is not None:
+            bar.close()
+    s = result.summary
+    if result.status == 'interrupted':
+        name = signal.Signals(stop.signal).name if stop.signal else 'signal'
+        print(f'ttb-sim: stopped by {name}; bag closed at {out} with {s["frames"]} frames',
+              file=sys.stderr)
+        return 128 + (stop.signal or signal.SIGINT)
+    if result.status == 'diverged':
+        print(f'ttb-sim: failed: {s["message"]}; bag closed at {out} with {s["frames"]} '
+              'frames', file=sys.stderr)
+        return EXIT_FAILURE
+    print(f'{out}: {s["frames"]} frames, {s["simulated_time"]:.3f} s simulated in '
+          f'{s["wall_time"]:.2f} s (real-time factor {s["real_time_factor"]:.3g})')
+    return EXIT_OK

@@ -36,17 +36,116 @@ import math
 import numpy as np
 import scipy.sparse as sp
 
-from ttb_sim.config.scenario import Scenario, TrainConfig
 from ttb_sim.fe.assembly import assemble, assemble_links, link_kinematics
 from ttb_sim.fe.beam import BeamSection, global_matrices, NODE_DOFS, vertical_row, W_DOFS
-from ttb_sim.model.track import BeamLine, build_track, TrackMesh
+from ttb_sim.model.track import BeamLine, build_track, TrackMesh, TrackParameters
+from ttb_sim.parameters import check_declared, param
 
 
-def train_length(train: TrainConfig) -> float:
-    """Return the length of the train from its head to its last axle or car end (m)."""
-    if train.vehicle == 'car':
-        return train.n_cars * train.car_length
-    return max(train.axle_positions())
+@dataclass(frozen=True)
+class BridgeParameters:
+    """Simply supported girders, modelled as 3-D Euler-Bernoulli beams."""
+
+    n_spans: int = param(1, '-', 'Number of simply supported spans.', low=1, high=50)
+    span_length: float = param(32.0, 'm', 'Length of each span between bearings.', low=0.0,
+                               high=500.0, low_inclusive=False)
+    bending_stiffness: float = param(4.646e11, 'N*m^2', 'Vertical bending stiffness EI of a '
+                                     'girder (E = 3.55e10 Pa, I = 13.088 m^4, [P] Table 3).',
+                                     low=0.0, high=1e16, low_inclusive=False)
+    lateral_bending_stiffness: float = param(3.087e12, 'N*m^2', 'Lateral bending stiffness '
+                                             '(I = 86.951 m^4, [P] Table 3).', low=0.0,
+                                             high=1e17, low_inclusive=False)
+    torsional_stiffness: float = param(3.4e11, 'N*m^2', 'Torsional stiffness GJ (G = E/2.4, '
+                                       'J = 22.984 m^4).', low=0.0, high=1e17,
+                                       low_inclusive=False)
+    axial_stiffness: float = param(3.16e11, 'N', 'Axial stiffness EA (A = 8.9 m^2 mid-span '
+                                   'box section).', low=0.0, high=1e16, low_inclusive=False)
+    mass_per_length: float = param(35200.0, 'kg/m', 'Mass per metre: 8.9 m^2 box girder plus '
+                                   '13 t/m secondary dead load (Table 3 prints 47.8 m^2, '
+                                   '119.5 t/m: see PHYSICS.md section 5).', low=0.0, high=1e7,
+                                   low_inclusive=False)
+    torsional_inertia: float = param(3.2e5, 'kg*m^2/m', 'Mass moment of inertia about the '
+                                     'girder axis per metre (assumed).', low=0.0, high=1e9,
+                                     low_inclusive=False)
+    damping_ratio: float = param(0.02, '-', 'Rayleigh damping ratio, exact at the first and '
+                                 'second vertical bending modes of a span.', low=0.0,
+                                 high=0.5, high_inclusive=False)
+    elements_per_span: int = param(16, '-', 'Beam elements per span (even, so that a node '
+                                   'sits at mid-span).', low=2, high=400)
+
+    def __post_init__(self) -> None:
+        """Check every field against its declaration."""
+        check_declared(self, 'bridge parameter')
+
+
+@dataclass(frozen=True)
+class BearingParameters:
+    """Bearings between girder ends and supports ([P] Eq. 1 as point springs)."""
+
+    model: str = param('rigid', '-', "'rigid': ideal pinned supports; 'elastic': "
+                       'spring-dashpot bearings on the supports.', choices=('rigid', 'elastic'))
+    spacing: float = param(4.4, 'm', 'Lateral distance between the left and right bearings '
+                           '(assumed).', low=0.0, high=50.0, low_inclusive=False)
+    vertical_stiffness: float = param(5e9, 'N/m', 'Vertical stiffness per bearing (assumed; '
+                                      'typical 1e9-1e10).', low=0.0, high=1e14,
+                                      low_inclusive=False)
+    lateral_stiffness: float = param(5e8, 'N/m', 'Lateral stiffness per bearing (assumed).',
+                                     low=0.0, high=1e14, low_inclusive=False)
+    longitudinal_stiffness: float = param(5e7, 'N/m', 'Longitudinal stiffness per bearing '
+                                          '(assumed).', low=0.0, high=1e14,
+                                          low_inclusive=False)
+    vertical_damping: float = param(0.0, 'N*s/m', 'Vertical damping per bearing.', low=0.0,
+                                    high=1e12)
+    lateral_damping: float = param(0.0, 'N*s/m', 'Lateral and longitudinal damping per '
+                                   'bearing.', low=0.0, high=1e12)
+
+    def __post_init__(self) -> None:
+        """Check every field against its declaration."""
+        check_declared(self, 'bearing parameter')
+
+
+@dataclass(frozen=True)
+class PierParameters:
+    """Pier columns under the intermediate supports (used with spring foundations)."""
+
+    height: float = param(10.0, 'm', 'Pier height from foundation to bearing.', low=0.0,
+                          high=200.0, low_inclusive=False)
+    axial_stiffness: float = param(2.6e11, 'N', 'Axial stiffness EA (C35, 8 m^2, assumed).',
+                                   low=0.0, high=1e16, low_inclusive=False)
+    bending_stiffness: float = param(2.6e11, 'N*m^2', 'Bending stiffness EI about both axes '
+                                     '(8 m^4, assumed).', low=0.0, high=1e16,
+                                     low_inclusive=False)
+    torsional_stiffness: float = param(2.2e11, 'N*m^2', 'Torsional stiffness GJ (assumed).',
+                                       low=0.0, high=1e16, low_inclusive=False)
+    mass_per_length: float = param(20000.0, 'kg/m', 'Mass per metre of pier (assumed).',
+                                   low=0.0, high=1e7, low_inclusive=False)
+    elements: int = param(4, '-', 'Beam elements per pier.', low=1, high=100)
+
+    def __post_init__(self) -> None:
+        """Check every field against its declaration."""
+        check_declared(self, 'pier parameter')
+
+
+@dataclass(frozen=True)
+class FoundationParameters:
+    """Foundations of the intermediate piers; abutments are always rigid."""
+
+    model: str = param('rigid', '-', "'rigid': bearings sit on fixed supports; 'springs': "
+                       'piers on foundation springs ([P] Table 4).',
+                       choices=('rigid', 'springs'))
+    vertical_stiffness: float = param(6e9, 'N/m', 'Vertical foundation spring ([P] Table 4).',
+                                      low=0.0, high=1e15, low_inclusive=False)
+    lateral_stiffness: float = param(6e8, 'N/m', 'Lateral and longitudinal foundation spring '
+                                     '([P] Table 4).', low=0.0, high=1e15, low_inclusive=False)
+    rotational_stiffness: float = param(1e11, 'N*m/rad', 'Rocking and twisting foundation '
+                                        'spring (assumed; not in [P]).', low=0.0, high=1e18,
+                                        low_inclusive=False)
+    damping: float = param(0.0, 'N*s/m', 'Translational foundation damping ([P] Table 4: 0).',
+                           low=0.0, high=1e12)
+
+    def __post_init__(self) -> None:
+        """Check every field against its declaration."""
+        check_declared(self, 'foundation parameter')
 
 
 @dataclass(frozen=True)
@@ -205,16 +304,26 @@ def rayleigh_coefficients(ratio: float, f1: float, f2: float) -> tuple[float, fl
     return 2 * ratio * w1 * w2 / (w1 + w2), 2 * ratio / (w1 + w2)
 
 
-def build_structure(scenario: Scenario) -> Structure:
+def assemble_structure(b: BridgeParameters, br: BearingParameters, pr: PierParameters,
+                       fd: FoundationParameters, track_parameters: TrackParameters | None,
+                       train_length: float) -> Structure:
     """
-    Assemble the bridge of a scenario (once, before time stepping).
+    Assemble girders, bearings, piers, foundations and the slab track (once).
+
+    Parameters
+    ----------
+    b, br, pr, fd
+        Girder, bearing, pier and foundation records.
+    track_parameters
+        The slab track, or None when loads act on the girder axis.
+    train_length
+        Head to last axle or car end (m): the automatic approach length.
 
     Returns
     -------
     Structure
 
     """
-    b, br, pr, fd = scenario.bridge, scenario.bearings, scenario.piers, scenario.foundation
     n_spans, ne, span = b.n_spans, b.elements_per_span, b.span_length
     n_supports = n_spans + 1
     piers = fd.model == 'springs'
@@ -254,9 +363,9 @@ def build_structure(scenario: Scenario) -> Structure:
     girder_beam = BeamLine(start=xg[girder_el[:, 0]], length=np.full(len(girder_el), span / ne),
                            dofs=girder_el_dofs, z=0.0)
     track = None
-    if scenario.track.model == 'slab':
-        track = build_track(scenario.track, span * n_spans, train_length(scenario.train),
-                            n_nodes, girder_beam)
+    if track_parameters is not None:
+        track = build_track(track_parameters, span * n_spans, train_length, n_nodes,
+                            girder_beam)
         coords.append(track.coords)
         conn.append(track.elements)
         sections.append(track.sections)

@@ -40,9 +40,90 @@ import math
 
 import numpy as np
 
-from ttb_sim.config.scenario import TrackConfig
 from ttb_sim.fe.assembly import link_kinematics
 from ttb_sim.fe.beam import BeamSection, field_rows, NODE_DOFS, offset_rows, point_rows
+from ttb_sim.parameters import check_declared, param
+
+
+@dataclass(frozen=True)
+class TrackParameters:
+    """
+    Track on the girders and on the approaches ([P] Tables 2 and 4).
+
+    ``slab``: two rails (3-D Euler beams) on discrete fasteners, a unit track
+    slab and base plate (3-D beams) on continuous spring-dashpot layers. The
+    dimensions of [P] Table 2 are those of CRTS III unit slabs.
+    """
+
+    model: str = param('none', '-', "'none': loads act on the girder axis; 'slab': rails on "
+                       'fasteners on unit slabs on base plates, continued onto approaches.',
+                       choices=('none', 'slab'))
+    approach_length: float = param(0.0, 'm', 'Track on rigid ground before and after the '
+                                   'bridge; 0 = train length + 20 m, so the whole train '
+                                   'starts and ends off the bridge.', low=0.0, high=5000.0)
+    rail_young_modulus: float = param(2.059e11, 'Pa', 'Rail elastic modulus ([P] Table 2).',
+                                      low=1e9, high=1e13)
+    rail_inertia_y: float = param(3.217e-5, 'm^4', 'Rail second moment about y (vertical '
+                                  'bending).', low=1e-8, high=1e-2)
+    rail_inertia_z: float = param(5.24e-6, 'm^4', 'Rail second moment about z (lateral '
+                                  'bending).', low=1e-8, high=1e-2)
+    rail_torsional_stiffness: float = param(1.958e5, 'N*m^2', 'Rail torsional stiffness GJ.',
+                                            low=1.0, high=1e9)
+    rail_polar_inertia: float = param(3.741e-5, 'm^4', 'Rail polar second moment (for the '
+                                      'rotary inertia).', low=1e-8, high=1e-2)
+    rail_mass: float = param(60.64, 'kg/m', 'Rail mass per metre.', low=1.0, high=1000.0)
+    rail_semi_spacing: float = param(0.7465, 'm', 'Lateral distance of each rail axis from the '
+                                     'track centre (at the wheel contact points).', low=0.3,
+                                     high=1.5)
+    rail_height: float = param(0.176, 'm', 'Rail height; the contact is at the top, the '
+                               'fastener at the foot, the axis at mid-height.', low=0.05,
+                               high=0.5)
+    fastener_spacing: float = param(0.63, 'm', 'Fastener spacing ([P] Table 2).', low=0.2,
+                                    high=2.0)
+    rail_elements_per_bay: int = param(2, '-', 'Rail beam elements between fasteners.',
+                                       low=1, high=16)
+    fastener_vertical_stiffness: float = param(5e7, 'N/m', 'Fastener vertical stiffness.',
+                                               low=1.0, high=1e12)
+    fastener_lateral_stiffness: float = param(3e7, 'N/m', 'Fastener lateral stiffness.',
+                                              low=1.0, high=1e12)
+    fastener_longitudinal_stiffness: float = param(2e7, 'N/m', 'Fastener longitudinal '
+                                                   'stiffness (assumed; not in [P]).', low=1.0,
+                                                   high=1e12)
+    fastener_vertical_damping: float = param(3.6e4, 'N*s/m', 'Fastener vertical damping.',
+                                             low=0.0, high=1e9)
+    fastener_lateral_damping: float = param(3e4, 'N*s/m', 'Fastener lateral (and '
+                                            'longitudinal) damping.', low=0.0, high=1e9)
+    rail_foot_width: float = param(0.15, 'm', 'Rail foot width: the pad resists rail roll '
+                                   'with k_v w^2 / 12.', low=0.01, high=0.5)
+    fasteners_per_slab: int = param(9, '-', 'Fasteners per slab unit (9 x 0.63 m = 5.67 m '
+                                    'pitch: 5.6 m slab + gap).', low=1, high=100)
+    slab_gap: float = param(0.07, 'm', 'Gap between slab units.', low=0.0, high=1.0)
+    slab_width: float = param(2.5, 'm', 'Track slab width.', low=0.5, high=10.0)
+    slab_thickness: float = param(0.21, 'm', 'Track slab thickness.', low=0.05, high=2.0)
+    slab_young_modulus: float = param(3.6e10, 'Pa', 'Slab concrete modulus (C60).', low=1e8,
+                                      high=1e12)
+    base_width: float = param(3.1, 'm', 'Base plate width.', low=0.5, high=10.0)
+    base_thickness: float = param(0.3, 'm', 'Base plate thickness.', low=0.05, high=2.0)
+    base_young_modulus: float = param(3.25e10, 'Pa', 'Base plate concrete modulus (C40).',
+                                      low=1e8, high=1e12)
+    concrete_density: float = param(2500.0, 'kg/m^3', 'Density of slab and base plate '
+                                    'concrete.', low=100.0, high=1e4)
+    filling_thickness: float = param(0.09, 'm', 'Self-compacting filling layer between slab '
+                                     'and base (its mass is shared between them).', low=0.0,
+                                     high=1.0)
+    layer_stiffness: float = param(1.5e9, 'N/m^2', 'Continuous layer stiffness per metre of '
+                                   'track, vertical and lateral ([P] Table 4); used between '
+                                   'slab and base, base and girder, base and ground.', low=1.0,
+                                   high=1e13)
+    layer_damping: float = param(8.3e4, 'N*s/m^2', 'Continuous layer damping per metre of '
+                                 'track ([P] Table 4).', low=0.0, high=1e10)
+    girder_top_height: float = param(1.1, 'm', 'Height of the girder top surface above the '
+                                     'girder axis.', low=0.0, high=10.0)
+
+    def __post_init__(self) -> None:
+        """Check every field against its declaration."""
+        check_declared(self, 'track parameter')
+
 
 POISSON_CONCRETE = 0.2
 STEEL_DENSITY = 7850.0
@@ -192,19 +273,19 @@ def _rect_section(n: int, young: float, width: float, thickness: float, density:
     return BeamSection(*(np.full(n, v) for v in values))
 
 
-def approach_length(track: TrackConfig, train_length: float) -> float:
+def approach_length(track: TrackParameters, train_length: float) -> float:
     """Return the approach length: as set, or the train length + 20 m (m)."""
     return track.approach_length or (train_length + 20.0)
 
 
-def build_track(track: TrackConfig, bridge_length: float, train_length: float,
+def build_track(track: TrackParameters, bridge_length: float, train_length: float,
                 first_node: int, girder: BeamLine) -> TrackMesh:
     """
     Build the track from x = -approach to bridge_length + approach.
 
     Parameters
     ----------
-    track : TrackConfig
+    track : TrackParameters
         Track keys of the scenario.
     bridge_length : float
         Total length of the girders (m); the bridge spans 0 .. bridge_length.

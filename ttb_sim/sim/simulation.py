@@ -27,11 +27,12 @@ from typing import Iterator
 
 import numpy as np
 
-from ttb_sim.config.scenario import parse_observers, Scenario
-from ttb_sim.errors import DivergenceError, ScenarioError
-from ttb_sim.model.bridge import bearing_forces, build_structure, Structure
-from ttb_sim.model.irregularity.profile import load_csv, synthesize, TrackIrregularity
-from ttb_sim.model.vehicle.train import build_vehicle, MovingForces, MultibodyCars, QuarterCars
+from ttb_sim.config import parse_observers, Scenario
+from ttb_sim.errors import DivergenceError
+from ttb_sim.model.bridge import bearing_forces
+from ttb_sim.model.irregularity.profile import TrackIrregularity
+from ttb_sim.model.vehicle.train import MovingForces, MultibodyCars, QuarterCars
+from ttb_sim.sim.build import build_irregularity, build_structure, build_vehicle, observer_rows
 from ttb_sim.sim.coupling.quarter_car import QuarterCarCoupling
 from ttb_sim.sim.coupling.train_track import TrainTrackCoupling
 from ttb_sim.sim.frames import Frame, Layout
@@ -84,85 +85,6 @@ CONTACT_STEP = 1e-4
 """Largest automatic time step with wheel-rail contact (s), the step of [P]."""
 
 
-def observer_rows(scenario: Scenario, structure: Structure) -> tuple[np.ndarray, np.ndarray]:
-    """
-    Return (extended free DOFs (n, 12), rows (n, 3, 12)) of the scenario's observers.
-
-    Raises
-    ------
-    ScenarioError
-        For an observer on a track component without a track, or outside the
-        component.
-
-    """
-    observers = parse_observers(scenario.output.observers)
-    dofs = np.zeros((len(observers), 12), dtype=int)
-    rows = np.zeros((len(observers), 3, 12))
-    ftf = structure.full_to_free
-    track = structure.track
-    for i, obs in enumerate(observers):
-        where = f'output.observers[{i}] = {obs.name}={obs.component}@{obs.x:g}'
-        if obs.component == 'girder':
-            line = structure.girder_beam
-        elif track is None:
-            raise ScenarioError(f'{where}: component {obs.component!r} needs '
-                                "track.model = 'slab'")
-        else:
-            line = {'rail_left': track.rails[0], 'rail_right': track.rails[1],
-                    'slab': track.slab, 'base': track.base}[obs.component]
-        element, r3, inside = line.rows(np.array([obs.x]), np.zeros(3))
-        if not inside[0]:
-            raise ScenarioError(f'{where}: x is not on the {obs.component}, which runs from '
-                                f'{line.start[0]:g} to {line.end:g} m (slab and base units '
-                                'have gaps)')
-        full = line.dofs[element[0]]
-        r = r3[0]
-        dofs[i] = ftf[full]
-        rows[i] = r
-    return dofs, rows
-
-
-PROFILE_MARGIN = 50.0
-"""Track synthesised beyond the positions the train covers in a planned passage (m)."""
-
-
-def build_irregularity(scenario: Scenario, train_length: float, bridge_length: float,
-                       extent: tuple[float, float] | None = None) -> TrackIrregularity | None:
-    """
-    Realise the scenario's track irregularity once (None for a smooth track).
-
-    A synthesised profile covers ``extent`` (the modelled track) or else the
-    track from behind the last axle at the start to the end of the bridge, with
-    a margin; a measured CSV profile is used as given. Outside the profile the
-    track is smooth.
-
-    Raises
-    ------
-    ScenarioError
-        For an unreadable or invalid CSV file (the message names the row).
-
-    """
-    irr = scenario.irregularity
-    if irr.scale == 0.0 or (irr.spectrum == 'none' and not irr.file):
-        return None
-    if irr.file:
-        profile = load_csv(irr.file)
-        if irr.scale == 1.0:
-            return profile
-        return TrackIrregularity(x_start=profile.x_start, dx=profile.dx,
-                                 values=profile.values * irr.scale,
-                                 slopes=profile.slopes * irr.scale,
-                                 curvatures=profile.curvatures * irr.scale,
-                                 source=profile.source)
-    if extent is not None:
-        x0, x1 = extent
-    else:
-        x0 = scenario.train.start_position - train_length - PROFILE_MARGIN
-        x1 = max(bridge_length, scenario.train.start_position) + PROFILE_MARGIN
-    return synthesize(irr.spectrum, length=x1 - x0, dx=irr.grid_spacing, seed=irr.seed,
-                      scale=irr.scale, x_start=x0)
-
-
 class Simulation:
     """
     One simulated passage of a train over the bridge.
@@ -177,7 +99,7 @@ class Simulation:
     def __init__(self, scenario: Scenario) -> None:
         self.scenario = scenario
         self.structure = build_structure(scenario)
-        self.vehicle = build_vehicle(scenario.train)
+        self.vehicle = build_vehicle(scenario)
         self.speed = scenario.train.speed
         st = self.structure
         vf = None

@@ -26,7 +26,7 @@ import math
 import numpy as np
 import pytest
 
-from ttb_sim.errors import ScenarioError
+from ttb_sim.errors import ModelError
 from ttb_sim.model.vehicle import car
 from ttb_sim.model.wheel_rail.contact import hertz_constant, linearised_stiffness
 
@@ -89,7 +89,7 @@ def test_v4_closed_form_estimates(matrices):
     assert np.min(np.abs(freq - f_pitch)) < 1e-9 * f_pitch
     k_eq = 1.0 / (1.0 / (4 * 0.4e6) + 1.0 / (8 * 1.04e6))
     assert freq[0] == pytest.approx(math.sqrt(k_eq / 48000.0) / (2 * math.pi), rel=0.01)
-    assert p.car_body_mass == 48000.0 and p.bogie_semi_distance == 7.85
+    assert p.car_body_mass == 48000.0 and p.bogie_semi_spacing == 7.85
 
 
 def test_matrices_symmetric_and_positive_semidefinite(matrices):
@@ -236,17 +236,17 @@ def test_damping_ratio_limits():
     Secondary-only estimate (PHYSICS.md 3.1): zeta = 4 C_sz / (2 sqrt(4 K_sz Mc))
     = 0.707 (tolerance 1 %).  The projected ratios scale with the damper counts.
     """
-    stiff_primary = car.CarParameters(primary_stiffness_z=1e12)
+    per_spring = dict(primary_vertical_dampers=8, secondary_vertical_dampers=4,
+                      secondary_lateral_dampers=4)  # one damper per spring position
+    stiff_primary = car.CarParameters(primary_stiffness_z=1e12, **per_spring)
     m, c, k = (car.mass_matrix(stiff_primary), car.damping_matrix(stiff_primary),
                car.stiffness_matrix(stiff_primary))
     subset = car.dofs(UPPER, ['z', 'pitch'])
     _, zeta = car.modal_damping_ratios(m, c, k, subset)
     expected = 4 * 98e3 / (2 * math.sqrt(4 * 0.4e6 * 48000))
     assert zeta[0] == pytest.approx(expected, rel=0.01)
-    default = car.car_matrices()
-    half = car.car_matrices(car.CarParameters(n_primary_vertical_dampers=4,
-                                              n_secondary_vertical_dampers=2,
-                                              n_secondary_lateral_dampers=2))
+    default = car.car_matrices(car.CarParameters(**per_spring))
+    half = car.car_matrices(car.CarParameters())  # the record's 4 / 2 / 2
     _, z_full = car.modal_damping_ratios(default.mass, default.damping, default.stiffness, subset)
     _, z_half = car.modal_damping_ratios(half.mass, half.damping, half.stiffness, subset)
     assert z_half == pytest.approx(0.5 * z_full, rel=1e-9)
@@ -272,11 +272,11 @@ def test_dof_helpers():
     assert car.dof(3, 'z') == 20
     assert car.dof('wheelset_4', 'pitch') == 40
     assert list(car.wheelset_dofs(0)) == list(range(18, 24))
-    with pytest.raises(ScenarioError, match='wheelset_9'):
+    with pytest.raises(ModelError, match='wheelset_9'):
         car.dof('wheelset_9', 'z')
-    with pytest.raises(ScenarioError, match='component'):
+    with pytest.raises(ModelError, match='component'):
         car.dof(0, 6)
-    with pytest.raises(ScenarioError, match='wheelset number'):
+    with pytest.raises(ModelError, match='wheelset number'):
         car.wheelset_dofs(4)
 
 
@@ -308,7 +308,7 @@ def test_gyroscopic_matrix():
     h = 200.0 * 83.3 / 0.46
     assert g[car.dof(3, 'yaw'), car.dof(3, 'roll')] == pytest.approx(h)
     assert np.count_nonzero(g) == 8
-    with pytest.raises(ScenarioError, match='speed'):
+    with pytest.raises(ModelError, match='speed'):
         car.gyroscopic_matrix(None, -1.0)
 
 
@@ -328,19 +328,19 @@ def test_train_matrices():
     assert t.gravity.sum() == pytest.approx(-8 * one.params.total_mass * G)
     short = car.train_matrices(n_cars=2, car_length=20.0)
     assert short.mass.shape == (84, 84)
-    with pytest.raises(ScenarioError, match='car_length'):
+    with pytest.raises(ModelError, match='car_length'):
         car.train_matrices(car_length=15.0)
-    with pytest.raises(ScenarioError, match='n_cars'):
+    with pytest.raises(ModelError, match='n_cars'):
         car.train_matrices(n_cars=0)
 
 
 def test_parameter_validation():
-    """Bad parameters raise ScenarioError naming the parameter, value and range."""
-    with pytest.raises(ScenarioError, match='car_body_mass = -1.0'):
+    """Bad parameters raise ModelError naming the parameter, value and range."""
+    with pytest.raises(ModelError, match='car_body_mass = -1.0'):
         car.CarParameters(car_body_mass=-1.0)
-    with pytest.raises(ScenarioError, match='n_secondary_vertical_dampers'):
-        car.CarParameters(n_secondary_vertical_dampers=2.5)
-    with pytest.raises(ScenarioError, match='axle_semi_distance'):
-        car.CarParameters(axle_semi_distance=8.0)
-    with pytest.raises(ScenarioError, match='vertical'):
+    with pytest.raises(ModelError, match='secondary_vertical_dampers'):
+        car.CarParameters(secondary_vertical_dampers=2.5)
+    with pytest.raises(ModelError, match='wheelbase_semi'):
+        car.CarParameters(wheelbase_semi=8.0)
+    with pytest.raises(ModelError, match='vertical'):
         car.contact_spring_stiffness(car.contact_map(), -1.0)

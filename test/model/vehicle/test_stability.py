@@ -195,12 +195,13 @@ def test_rigid_body_roots_are_removed_exactly(table_geometry: st.LinearGeometry)
     assert np.linalg.norm(resid) < 1e-8 * scale
 
 
-#: Damper counts per car: CarParameters defaults (8 / 4 / 4) and the scenario
-#: defaults (4 / 2 / 2) with which the time-domain observations were made.
+#: Damper counts per car: one damper per spring position (8 / 4 / 4) and the car
+#: record's defaults (4 / 2 / 2) with which the time-domain observations were made.
 DAMPER_COUNTS = {
-    'car_defaults': {},
-    'scenario_defaults': {'n_primary_vertical_dampers': 4, 'n_secondary_vertical_dampers': 2,
-                          'n_secondary_lateral_dampers': 2},
+    'car_defaults': {'primary_vertical_dampers': 8, 'secondary_vertical_dampers': 4,
+                     'secondary_lateral_dampers': 4},
+    'scenario_defaults': {'primary_vertical_dampers': 4, 'secondary_vertical_dampers': 2,
+                          'secondary_lateral_dampers': 2},
 }
 
 
@@ -217,7 +218,7 @@ def test_car_without_yaw_dampers_hunts_between_200_and_300_kmh(
     The unstable mode is bogie hunting: 4.5 Hz, Re(lambda) = +1.34 1/s
     (+1.41 1/s with the scenario counts) at 300 km/h.
     """
-    p = CarParameters(n_yaw_dampers=0, **DAMPER_COUNTS[counts])
+    p = CarParameters(yaw_dampers=0, **DAMPER_COUNTS[counts])
     v_cr = st.critical_speed(p, table_geometry, speed_range=(20.0, 120.0), n_scan=11)
     assert 200.0 * KMH < v_cr < 300.0 * KMH
     assert v_cr / KMH == pytest.approx(expected_kmh, abs=0.5)
@@ -249,7 +250,7 @@ def test_critical_speed_refuses_a_bracket_that_starts_unstable(
         table_geometry: st.LinearGeometry) -> None:
     """A scan starting above the critical speed is refused, stable ranges give inf."""
     from ttb_sim.errors import ScenarioError
-    p = CarParameters(n_yaw_dampers=0)
+    p = CarParameters(yaw_dampers=0)
     with pytest.raises(ScenarioError, match='unstable already'):
         st.critical_speed(p, table_geometry, speed_range=(300.0 * KMH, 400.0 * KMH))
     assert st.critical_speed(p, table_geometry, speed_range=(20.0, 60.0), n_scan=3) == math.inf

@@ -102,7 +102,7 @@ two air springs (the secondary suspension sits at the bogie centre).
 
 from __future__ import annotations
 
-from dataclasses import dataclass, fields
+from dataclasses import dataclass
 import math
 from typing import Sequence
 
@@ -110,10 +110,9 @@ import numpy as np
 import scipy.linalg
 import scipy.sparse
 
-from ttb_sim.errors import ScenarioError
-
-#: Standard gravity used for the gravity loads (m/s^2).
-GRAVITY = 9.81
+from ttb_sim.errors import ModelError
+from ttb_sim.model.constants import GRAVITY
+from ttb_sim.parameters import check_declared, param
 
 #: Names of the seven bodies, in DOF order.
 BODY_NAMES = ('car_body', 'bogie_1', 'bogie_2',
@@ -138,12 +137,12 @@ def _index(names: Sequence[str], key: int | str, what: str) -> int:
     if isinstance(key, str):
         if key not in names:
             msg = f'{what} {key!r} is unknown; allowed: {", ".join(names)}'
-            raise ScenarioError(msg)
+            raise ModelError(msg)
         return names.index(key)
     value = int(key)
     if not 0 <= value < len(names):
         msg = f'{what} index {key} is out of range; allowed: 0..{len(names) - 1}'
-        raise ScenarioError(msg)
+        raise ModelError(msg)
     return value
 
 
@@ -165,7 +164,7 @@ def dof(body: int | str, component: int | str) -> int:
 
     Raises
     ------
-    ScenarioError
+    ModelError
         If the body or component is unknown.
 
     """
@@ -209,124 +208,110 @@ def wheelset_dofs(j: int) -> np.ndarray:
 
     """
     if not 0 <= int(j) < 4:
-        raise ScenarioError(f'wheelset number {j} is out of range; allowed: 0..3')
+        raise ModelError(f'wheelset number {j} is out of range; allowed: 0..3')
     return dofs([WHEELSETS[int(j)]], COMPONENTS)
 
 
 @dataclass(frozen=True)
 class CarParameters:
     """
-    Parameters of one car; defaults are [P] Table 1 plus documented assumptions.
+    One car ([P] Table 1 plus documented assumptions); the scenario's ``car`` section.
 
-    Units are SI: masses kg, inertias kg m^2, stiffness per spring N/m,
-    damping per damper N s/m, lengths m.  Stiffness and damping values are per
-    element; the element counts are fixed for springs (8 axle boxes, 4 air
-    springs) and given by the ``n_*_dampers`` fields for dampers.
-
-    Attributes
-    ----------
-    n_primary_vertical_dampers, n_secondary_vertical_dampers : int
-        Dampers per car (default 8 and 4, one per spring position), smeared
-        evenly over the 8 axle boxes / 4 air springs.
-    n_secondary_lateral_dampers : int
-        Secondary lateral dampers per car (default 4).
-    yaw_damping : float
-        Longitudinal (anti-yaw) damper coefficient between bogie frame and car
-        body, per damper (N s/m; assumed 250e3, not in [P] Table 1).
-    n_yaw_dampers : int
-        Anti-yaw dampers per car (default 4: one on each side of each bogie,
-        smeared over the 4 positions); 0 gives the literal Table 1 car.
-    yaw_damper_semi_spacing : float
-        Lateral semi-spacing of the anti-yaw dampers (assumed 1.35 m).
-    bogie_semi_distance, axle_semi_distance : float
-        l_c = 7.85 m and l_t = 1.25 m.
-    wheel_radius : float
-        Nominal rolling radius r0 = 0.46 m.
-    contact_semi_distance : float
-        b = 0.7465 m, half the lateral distance between the contact points.
-    primary_semi_spacing, secondary_semi_spacing : float
-        Lateral semi-spacing of the axle-box springs and of the air springs
-        (assumed 1.0 m each).
-    car_body_cg_height, secondary_height, bogie_cg_height : float
-        Heights above the rail top (assumed 1.70, 0.90, 0.46 m).
-    longitudinal_pitch_coupling : bool
-        False (default): longitudinal suspension forces have no pitch moment
-        arm (Zhai-type model); True: they act at the physical heights.
-
+    Units are SI: masses kg, inertias kg m^2, stiffness per spring N/m (8 axle
+    boxes and 4 air springs per car), damping per damper N s/m (the ``*_dampers``
+    counts say how many act per car, smeared evenly over the spring positions),
+    lengths m.  Every field is declared with :func:`~ttb_sim.parameters.param`,
+    so it is settable from a scenario file as ``car.<field>``.
     """
 
-    car_body_mass: float = 48000.0
-    bogie_mass: float = 3200.0
-    wheelset_mass: float = 2400.0
-    car_body_roll_inertia: float = 1.15e5
-    car_body_pitch_inertia: float = 2.3e6
-    car_body_yaw_inertia: float = 2.3e6
-    bogie_roll_inertia: float = 3200.0
-    bogie_pitch_inertia: float = 7200.0
-    bogie_yaw_inertia: float = 6800.0
-    wheelset_roll_inertia: float = 1200.0
-    wheelset_pitch_inertia: float = 200.0
-    wheelset_yaw_inertia: float = 1200.0
-    primary_stiffness_x: float = 9.0e6
-    primary_stiffness_y: float = 3.0e6
-    primary_stiffness_z: float = 1.04e6
-    secondary_stiffness_x: float = 0.24e6
-    secondary_stiffness_y: float = 0.24e6
-    secondary_stiffness_z: float = 0.4e6
-    primary_damping_z: float = 45.0e3
-    secondary_damping_y: float = 3.0e3
-    secondary_damping_z: float = 98.0e3
-    yaw_damping: float = 250.0e3
-    n_primary_vertical_dampers: int = 8
-    n_secondary_vertical_dampers: int = 4
-    n_secondary_lateral_dampers: int = 4
-    n_yaw_dampers: int = 4
-    yaw_damper_semi_spacing: float = 1.35
-    bogie_semi_distance: float = 7.85
-    axle_semi_distance: float = 1.25
-    wheel_radius: float = 0.46
-    contact_semi_distance: float = 0.7465
-    primary_semi_spacing: float = 1.0
-    secondary_semi_spacing: float = 1.0
-    car_body_cg_height: float = 1.70
-    secondary_height: float = 0.90
-    bogie_cg_height: float = 0.46
-    longitudinal_pitch_coupling: bool = False
+    car_body_mass: float = param(48000.0, 'kg', 'Car body mass M_c.', low=1.0, high=1e6)
+    bogie_mass: float = param(3200.0, 'kg', 'Bogie frame mass M_t.', low=1.0, high=1e5)
+    wheelset_mass: float = param(2400.0, 'kg', 'Wheelset mass M_w.', low=1.0, high=1e5)
+    car_body_pitch_inertia: float = param(2.3e6, 'kg*m^2', 'Car body pitch inertia I_cy.',
+                                          low=1.0, high=1e9)
+    car_body_roll_inertia: float = param(1.15e5, 'kg*m^2', 'Car body roll inertia I_cx.',
+                                         low=1.0, high=1e9)
+    car_body_yaw_inertia: float = param(2.3e6, 'kg*m^2', 'Car body yaw inertia I_cz.',
+                                        low=1.0, high=1e9)
+    bogie_pitch_inertia: float = param(7200.0, 'kg*m^2', 'Bogie pitch inertia I_ty.', low=1.0,
+                                       high=1e7)
+    bogie_roll_inertia: float = param(3200.0, 'kg*m^2', 'Bogie roll inertia I_tx.', low=1.0,
+                                      high=1e7)
+    bogie_yaw_inertia: float = param(6800.0, 'kg*m^2', 'Bogie yaw inertia I_tz.', low=1.0,
+                                     high=1e7)
+    wheelset_roll_inertia: float = param(1200.0, 'kg*m^2', 'Wheelset roll inertia I_wx.',
+                                         low=1.0, high=1e6)
+    wheelset_spin_inertia: float = param(200.0, 'kg*m^2', 'Wheelset inertia about its axle '
+                                         'I_wy (spin perturbation and gyroscopic terms).',
+                                         low=1.0, high=1e6)
+    wheelset_yaw_inertia: float = param(1200.0, 'kg*m^2', 'Wheelset yaw inertia I_wz.',
+                                        low=1.0, high=1e6)
+    primary_stiffness_x: float = param(9.0e6, 'N/m', 'Primary longitudinal stiffness per '
+                                       'axle box.', low=1.0, high=1e13)
+    primary_stiffness_y: float = param(3.0e6, 'N/m', 'Primary lateral stiffness per axle box.',
+                                       low=1.0, high=1e13)
+    primary_stiffness_z: float = param(1.04e6, 'N/m', 'Primary vertical stiffness per axle '
+                                       'box.', low=1.0, high=1e13)
+    secondary_stiffness_x: float = param(0.24e6, 'N/m', 'Secondary longitudinal stiffness per '
+                                         'air spring.', low=1.0, high=1e13)
+    secondary_stiffness_y: float = param(0.24e6, 'N/m', 'Secondary lateral stiffness per air '
+                                         'spring.', low=1.0, high=1e13)
+    secondary_stiffness_z: float = param(0.4e6, 'N/m', 'Secondary vertical stiffness per air '
+                                         'spring.', low=1.0, high=1e13)
+    primary_damping_z: float = param(45.0e3, 'N*s/m', 'Primary vertical damping per damper.',
+                                     low=0.0, high=1e9)
+    secondary_damping_y: float = param(3.0e3, 'N*s/m', 'Secondary lateral damping per damper.',
+                                       low=0.0, high=1e9)
+    secondary_damping_z: float = param(98.0e3, 'N*s/m', 'Secondary vertical damping per '
+                                       'damper.', low=0.0, high=1e9)
+    primary_vertical_dampers: int = param(4, '-', 'Primary vertical dampers per car (one per '
+                                          'wheelset: Zhai-type bogies carry one damper per '
+                                          'side of each bogie; see README).', low=0, high=64)
+    secondary_vertical_dampers: int = param(2, '-', 'Secondary vertical dampers per car (one '
+                                            'per bogie).', low=0, high=64)
+    secondary_lateral_dampers: int = param(2, '-', 'Secondary lateral dampers per car (one '
+                                           'per bogie).', low=0, high=64)
+    yaw_damping: float = param(250.0e3, 'N*s/m', 'Anti-yaw (longitudinal) damper between '
+                               'bogie and car body, per damper; assumed, not in [P] Table 1 '
+                               '(see README).', low=0.0, high=1e9)
+    yaw_dampers: int = param(4, '-', 'Anti-yaw dampers per car (one on each side of each bogie; '
+                             '0 = the literal Table 1 car).', low=0, high=64)
+    yaw_damper_semi_spacing: float = param(1.35, 'm', 'Lateral semi-spacing of the anti-yaw '
+                                           'dampers (assumed).', low=0.1, high=2.0)
+    bogie_semi_spacing: float = param(7.85, 'm', 'Half the distance between bogie centres '
+                                      '(l_c, [P] Table 1); also sets the axle layout of '
+                                      'moving forces and quarter cars.', low=0.1, high=30.0)
+    wheelbase_semi: float = param(1.25, 'm', 'Half the bogie wheelbase (l_t, [P] Table 1).',
+                                  low=0.1, high=5.0)
+    wheel_radius: float = param(0.46, 'm', 'Nominal rolling radius r0.', low=0.1, high=2.0)
+    contact_semi_distance: float = param(0.7465, 'm', 'Half the lateral distance between '
+                                         'the contact points b.', low=0.3, high=1.5)
+    primary_semi_spacing: float = param(1.0, 'm', 'Lateral semi-spacing of the axle-box '
+                                        'springs (assumed).', low=0.1, high=3.0)
+    secondary_semi_spacing: float = param(1.0, 'm', 'Lateral semi-spacing of the air springs '
+                                          '(assumed).', low=0.1, high=3.0)
+    car_body_cg_height: float = param(1.70, 'm', 'Car body centre of gravity above the rail '
+                                      'top (assumed).', low=0.1, high=5.0)
+    secondary_height: float = param(0.90, 'm', 'Height of the air springs above the rail top '
+                                    '(assumed).', low=0.1, high=5.0)
+    bogie_cg_height: float = param(0.46, 'm', 'Bogie centre of gravity above the rail top '
+                                   '(assumed).', low=0.1, high=5.0)
+    longitudinal_pitch_coupling: bool = param(False, '-', 'False: longitudinal suspension '
+                                              'forces have no pitch moment arm (Zhai-type '
+                                              'model); true: they act at the physical '
+                                              'heights.')
 
     def __post_init__(self) -> None:
-        counts = ('n_primary_vertical_dampers', 'n_secondary_vertical_dampers',
-                  'n_secondary_lateral_dampers', 'n_yaw_dampers')
-        dampers = ('primary_damping_z', 'secondary_damping_y', 'secondary_damping_z',
-                   'yaw_damping')
-        flags = ('longitudinal_pitch_coupling',)
-        positive = {f.name for f in fields(self)} - {*counts, *dampers, *flags}
-        if not isinstance(self.longitudinal_pitch_coupling, bool):
-            msg = ('car parameter longitudinal_pitch_coupling = '
-                   f'{self.longitudinal_pitch_coupling!r} is invalid; allowed: true or false')
-            raise ScenarioError(msg)
-        for name in sorted(positive):
-            value = getattr(self, name)
-            if not (isinstance(value, (int, float)) and math.isfinite(value) and value > 0.0):
-                msg = f'car parameter {name} = {value!r} is invalid; allowed: finite and > 0'
-                raise ScenarioError(msg)
-        for name in dampers:
-            value = getattr(self, name)
-            if not (isinstance(value, (int, float)) and math.isfinite(value) and value >= 0.0):
-                msg = f'car parameter {name} = {value!r} is invalid; allowed: finite and >= 0'
-                raise ScenarioError(msg)
-        for name in counts:
-            value = getattr(self, name)
-            if isinstance(value, bool) or not isinstance(value, int) or not 0 <= value <= 64:
-                msg = f'car parameter {name} = {value!r} is invalid; allowed: integer 0..64'
-                raise ScenarioError(msg)
-        if self.axle_semi_distance >= self.bogie_semi_distance:
-            msg = (f'car parameter axle_semi_distance = {self.axle_semi_distance!r} is '
-                   f'invalid; allowed: < bogie_semi_distance ({self.bogie_semi_distance})')
-            raise ScenarioError(msg)
-        if self.wheel_radius >= self.axle_semi_distance:
+        """Check every field against its declaration, then the geometric rules."""
+        check_declared(self, 'car parameter')
+        if self.wheelbase_semi >= self.bogie_semi_spacing:
+            msg = (f'car parameter wheelbase_semi = {self.wheelbase_semi!r} is invalid; '
+                   f'allowed: < bogie_semi_spacing ({self.bogie_semi_spacing})')
+            raise ModelError(msg)
+        if self.wheel_radius >= self.wheelbase_semi:
             msg = (f'car parameter wheel_radius = {self.wheel_radius!r} is invalid; '
-                   f'allowed: < axle_semi_distance ({self.axle_semi_distance})')
-            raise ScenarioError(msg)
+                   f'allowed: < wheelbase_semi ({self.wheelbase_semi})')
+            raise ModelError(msg)
 
     @property
     def static_wheel_load(self) -> float:
@@ -375,7 +360,7 @@ def body_positions(params: CarParameters | None = None) -> np.ndarray:
 
     """
     p = params or CarParameters()
-    lc, lt = p.bogie_semi_distance, p.axle_semi_distance
+    lc, lt = p.bogie_semi_spacing, p.wheelbase_semi
     x = np.array([0.0, lc, -lc, lc + lt, lc - lt, -lc + lt, -lc - lt])
     z = np.array([p.car_body_cg_height, p.bogie_cg_height, p.bogie_cg_height]
                  + [p.wheel_radius] * 4)
@@ -403,7 +388,7 @@ def mass_matrix(params: CarParameters | None = None) -> np.ndarray:
                                  p.car_body_yaw_inertia],
         *([[p.bogie_mass] * 3 + [p.bogie_roll_inertia, p.bogie_pitch_inertia,
                                  p.bogie_yaw_inertia]] * 2),
-        *([[p.wheelset_mass] * 3 + [p.wheelset_roll_inertia, p.wheelset_pitch_inertia,
+        *([[p.wheelset_mass] * 3 + [p.wheelset_roll_inertia, p.wheelset_spin_inertia,
                                     p.wheelset_yaw_inertia]] * 4),
     ])
     return np.diag(diag.ravel())
@@ -462,10 +447,10 @@ def suspension_elements(params: CarParameters | None = None) -> SuspensionElemen
     pos = body_positions(p)
     body_a, body_b, point, stiff, damp, group = [], [], [], [], [], []
     # Dampers smeared evenly over the spring positions (8 axle boxes, 4 air springs).
-    c_pz = p.primary_damping_z * p.n_primary_vertical_dampers / 8.0
-    c_sz = p.secondary_damping_z * p.n_secondary_vertical_dampers / 4.0
-    c_sy = p.secondary_damping_y * p.n_secondary_lateral_dampers / 4.0
-    c_yaw = p.yaw_damping * p.n_yaw_dampers / 4.0
+    c_pz = p.primary_damping_z * p.primary_vertical_dampers / 8.0
+    c_sz = p.secondary_damping_z * p.secondary_vertical_dampers / 4.0
+    c_sy = p.secondary_damping_y * p.secondary_lateral_dampers / 4.0
+    c_yaw = p.yaw_damping * p.yaw_dampers / 4.0
     for i, bogie in enumerate(BOGIES):
         for side in SIDES if c_yaw > 0.0 else ():
             body_a.append(CAR_BODY)
@@ -616,8 +601,8 @@ def gyroscopic_matrix(params: CarParameters | None, speed: float) -> np.ndarray:
     """
     p = params or CarParameters()
     if not (math.isfinite(speed) and speed >= 0.0):
-        raise ScenarioError(f'speed = {speed!r} m/s is invalid; allowed: finite and >= 0')
-    h = p.wheelset_pitch_inertia * speed / p.wheel_radius
+        raise ModelError(f'speed = {speed!r} m/s is invalid; allowed: finite and >= 0')
+    h = p.wheelset_spin_inertia * speed / p.wheel_radius
     g = np.zeros((N_DOF, N_DOF))
     for w in WHEELSETS:
         roll, yaw = dof(w, 'roll'), dof(w, 'yaw')
@@ -746,7 +731,7 @@ def contact_spring_stiffness(cmap: ContactMap, vertical: float, lateral: float =
     for name, value in (('vertical', vertical), ('lateral', lateral),
                         ('longitudinal', longitudinal)):
         if not (math.isfinite(value) and value >= 0.0):
-            raise ScenarioError(f'contact spring {name} = {value!r} N/m is invalid; '
+            raise ModelError(f'contact spring {name} = {value!r} N/m is invalid; '
                                 'allowed: finite and >= 0')
     return (vertical * cmap.hz.T @ cmap.hz + lateral * cmap.hy.T @ cmap.hy
             + longitudinal * cmap.hx.T @ cmap.hx)
@@ -935,19 +920,19 @@ def train_matrices(params: CarParameters | None = None, n_cars: int = 8,
 
     Raises
     ------
-    ScenarioError
+    ModelError
         If ``n_cars`` or ``car_length`` is out of range.
 
     """
     p = params or CarParameters()
     if isinstance(n_cars, bool) or not isinstance(n_cars, (int, np.integer)) \
             or not 1 <= n_cars <= 64:
-        raise ScenarioError(f'train n_cars = {n_cars!r} is invalid; allowed: integer 1..64')
-    min_length = 2.0 * (p.bogie_semi_distance + p.axle_semi_distance + p.wheel_radius)
+        raise ModelError(f'train n_cars = {n_cars!r} is invalid; allowed: integer 1..64')
+    min_length = 2.0 * (p.bogie_semi_spacing + p.wheelbase_semi + p.wheel_radius)
     if not (math.isfinite(car_length) and min_length <= car_length <= 100.0):
         msg = (f'train car_length = {car_length!r} m is invalid; '
                f'allowed: {min_length:.3f}..100 m')
-        raise ScenarioError(msg)
+        raise ModelError(msg)
     car = car_matrices(p)
     cm = car.contacts
     eye = scipy.sparse.identity(n_cars, format='csr')

@@ -23,11 +23,11 @@ ground off it. Vehicle displacements are measured from static equilibrium, z up.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 
 import numpy as np
 
-from ttb_sim.config.scenario import G, TrainConfig
+from ttb_sim.model.constants import GRAVITY
 
 
 @dataclass(frozen=True)
@@ -69,7 +69,7 @@ class QuarterCars:
     @property
     def static_load(self) -> np.ndarray:
         """Static contact force of each wheel (N)."""
-        return (self.sprung_mass + self.unsprung_mass) * G
+        return (self.sprung_mass + self.unsprung_mass) * GRAVITY
 
     def natural_frequency(self) -> np.ndarray:
         """Bounce frequency of each sprung mass on its suspension, wheel fixed (Hz)."""
@@ -96,19 +96,3 @@ class MultibodyCars:
 
 
 Vehicle = MovingForces | QuarterCars | MultibodyCars
-
-
-def build_vehicle(train: TrainConfig) -> Vehicle:
-    """Build the vehicle model a scenario's train section describes."""
-    axles = Axles(offsets=np.asarray(train.axle_positions(), dtype=float))
-    n = axles.count
-    if train.vehicle == 'car':
-        layout = replace(train, axle_offsets=()).axle_positions()
-        return MultibodyCars(axles=Axles(offsets=np.asarray(layout, dtype=float)),
-                             n_cars=train.n_cars, car_length=train.car_length)
-    if train.vehicle == 'moving_force':
-        return MovingForces(axles=axles, loads=np.full(n, train.axle_load))
-    return QuarterCars(axles=axles, sprung_mass=np.full(n, train.sprung_mass),
-                       unsprung_mass=np.full(n, train.unsprung_mass),
-                       stiffness=np.full(n, train.suspension_stiffness),
-                       damping=np.full(n, train.suspension_damping))

@@ -29,8 +29,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from ttb_sim.config.scenario import G
 from ttb_sim.model.bridge import GirderLine
+from ttb_sim.model.constants import GRAVITY
 from ttb_sim.model.vehicle.train import QuarterCars
 from ttb_sim.sim.integrators.newmark import Newmark
 
@@ -117,7 +117,7 @@ class QuarterCarCoupling:
         p = c[:, None] * g_v + k[:, None] * n0
         e = c * c_v + k * c_z - ms * hs_a - c * hs_v
         w = mu[:, None] * g_a + (ms * a0 / d)[:, None] * p
-        b = (ms + mu) * G + mu * c_a + k * c_z + c * c_v - q * e / d - c * hs_v
+        b = (ms + mu) * GRAVITY + mu * c_a + k * c_z + c * c_v - q * e / d - c * hs_v
 
         m = n0.shape[0]
         rhs, sol = self._rhs, self._sol

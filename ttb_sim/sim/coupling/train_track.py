@@ -55,14 +55,13 @@ import math
 import numpy as np
 import scipy.sparse.linalg as sla
 
-from ttb_sim.config.scenario import Scenario
+from ttb_sim.config import Scenario
 from ttb_sim.errors import DivergenceError
 from ttb_sim.fe.beam import point_rows
 from ttb_sim.model.bridge import Structure
 from ttb_sim.model.irregularity.profile import TrackIrregularity
 from ttb_sim.model.track import BeamLine
-from ttb_sim.model.vehicle.car import (CarParameters, dofs as car_dofs, gyroscopic_matrix,
-                                       train_matrices)
+from ttb_sim.model.vehicle.car import dofs as car_dofs, gyroscopic_matrix, train_matrices
 from ttb_sim.model.wheel_rail import contact as ct
 from ttb_sim.model.wheel_rail.profiles import contact_geometry_table
 from ttb_sim.sim.integrators.newmark import Newmark
@@ -75,33 +74,6 @@ COMPONENTS = 4
 """Contact force components per wheel: Fx, Fy, Fz (on the wheel), Mz (spin moment)."""
 GEOMETRY_STEP = 1e-6
 """Lateral step (m) of the central difference of the rigid-contact wheel height."""
-
-
-def car_parameters(scenario: Scenario) -> CarParameters:
-    """Return the car parameters of a scenario's ``car`` and ``train`` sections."""
-    c, t = scenario.car, scenario.train
-    return CarParameters(
-        car_body_mass=c.car_body_mass, bogie_mass=c.bogie_mass, wheelset_mass=c.wheelset_mass,
-        car_body_roll_inertia=c.car_body_roll_inertia,
-        car_body_pitch_inertia=c.car_body_pitch_inertia,
-        car_body_yaw_inertia=c.car_body_yaw_inertia,
-        bogie_roll_inertia=c.bogie_roll_inertia, bogie_pitch_inertia=c.bogie_pitch_inertia,
-        bogie_yaw_inertia=c.bogie_yaw_inertia, wheelset_roll_inertia=c.wheelset_roll_inertia,
-        wheelset_pitch_inertia=c.wheelset_spin_inertia,
-        wheelset_yaw_inertia=c.wheelset_yaw_inertia,
-        primary_stiffness_x=c.primary_stiffness_x, primary_stiffness_y=c.primary_stiffness_y,
-        primary_stiffness_z=c.primary_stiffness_z,
-        secondary_stiffness_x=c.secondary_stiffness_x,
-        secondary_stiffness_y=c.secondary_stiffness_y,
-        secondary_stiffness_z=c.secondary_stiffness_z,
-        primary_damping_z=c.primary_damping_z, secondary_damping_y=c.secondary_damping_y,
-        secondary_damping_z=c.secondary_damping_z, yaw_damping=c.yaw_damping,
-        n_yaw_dampers=c.yaw_dampers, yaw_damper_semi_spacing=c.yaw_damper_semi_spacing,
-        n_primary_vertical_dampers=c.primary_vertical_dampers,
-        n_secondary_vertical_dampers=c.secondary_vertical_dampers,
-        n_secondary_lateral_dampers=c.secondary_lateral_dampers,
-        bogie_semi_distance=t.bogie_semi_spacing, axle_semi_distance=t.wheelbase_semi,
-        wheel_radius=c.wheel_radius, contact_semi_distance=c.contact_semi_distance)
 
 
 @dataclass(frozen=True)
@@ -184,7 +156,7 @@ class TrainTrackCoupling:
         self.structure = structure
         self.nm = integrator
         self.irregularity = irregularity
-        self.params = car_parameters(scenario)
+        self.params = scenario.car
         p = self.params
         tm = train_matrices(p, scenario.train.n_cars, scenario.train.car_length)
         self.n_cars = tm.n_cars

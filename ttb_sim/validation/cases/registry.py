@@ -27,7 +27,7 @@ from typing import Sequence
 import numpy as np
 import scipy.sparse as sp
 
-from ttb_sim.config.scenario import load_scenario, Scenario
+from ttb_sim.config import load_scenario, Scenario
 from ttb_sim.sim.integrators.newmark import Newmark
 from ttb_sim.sim.simulation import Simulation
 from ttb_sim.validation.cases.components import COMPONENT_CASES

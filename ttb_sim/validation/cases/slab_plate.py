@@ -52,7 +52,7 @@ import scipy.linalg as la
 import scipy.sparse as sp
 import scipy.sparse.linalg as sla
 
-from ttb_sim.config.scenario import TrackConfig
+from ttb_sim.config import TrackParameters
 from ttb_sim.fe.assembly import assemble, assemble_links
 from ttb_sim.fe.beam import global_matrices, NODE_DOFS
 from ttb_sim.fe.mindlin import MindlinPlate, plate_matrices, PlateMesh, rectangular_mesh
@@ -134,14 +134,14 @@ class Comparison:
     beam_only: tuple[tuple[str, float], ...]
 
 
-def unit_track(track: TrackConfig | None = None) -> TrackMesh:
+def unit_track(track: TrackParameters | None = None) -> TrackMesh:
     """
     Build a track of exactly one slab unit with the pipeline's own builder.
 
     The girder is replaced by rigid ground (DOFs -1), so the base plate's lower
     layer is grounded. Node numbers start at 0.
     """
-    track = replace(track or TrackConfig(), model='slab')
+    track = replace(track or TrackParameters(), model='slab')
     pitch = track.fasteners_per_slab * track.fastener_spacing
     track = replace(track, approach_length=0.2499 * pitch)
     ground = BeamLine(start=np.zeros(1), length=np.array([0.5 * pitch]),
@@ -152,7 +152,7 @@ def unit_track(track: TrackConfig | None = None) -> TrackMesh:
     return mesh
 
 
-def _component(track: TrackConfig, component: str) -> tuple[float, float, float, int]:
+def _component(track: TrackParameters, component: str) -> tuple[float, float, float, int]:
     """Return (width, thickness, modulus, link set index) of 'slab' or 'base'."""
     if component == 'slab':
         return track.slab_width, track.slab_thickness, track.slab_young_modulus, 1
@@ -179,7 +179,7 @@ class BeamUnit:
 
 
 def beam_unit(component: str = 'slab', on_layer: bool = False,
-              track: TrackConfig | None = None) -> BeamUnit:
+              track: TrackParameters | None = None) -> BeamUnit:
     """
     Return the pipeline's beam of one slab (or base plate) unit.
 
@@ -190,11 +190,11 @@ def beam_unit(component: str = 'slab', on_layer: bool = False,
     on_layer : bool
         Add the continuous layer under it (slab: on a rigid base plate; base
         plate: on rigid ground), as assembled by the pipeline.
-    track : TrackConfig, optional
+    track : TrackParameters, optional
         Track keys; the defaults ([P] Tables 2 and 4) when omitted.
 
     """
-    track = track or TrackConfig()
+    track = track or TrackParameters()
     mesh = unit_track(track)
     _, _, _, link_index = _component(track, component)
     line = mesh.slab if component == 'slab' else mesh.base
@@ -219,7 +219,7 @@ def beam_unit(component: str = 'slab', on_layer: bool = False,
     return BeamUnit(k[local][:, local].toarray(), m[local][:, local].toarray(), line, local, x)
 
 
-def plate_of(component: str = 'slab', track: TrackConfig | None = None) -> MindlinPlate:
+def plate_of(component: str = 'slab', track: TrackParameters | None = None) -> MindlinPlate:
     """
     Return the Mindlin plate of a slab or base-plate unit.
 
@@ -227,7 +227,7 @@ def plate_of(component: str = 'slab', track: TrackConfig | None = None) -> Mindl
     the beam section's mass per length (filling-layer share included) over the
     width.
     """
-    track = track or TrackConfig()
+    track = track or TrackParameters()
     width, thickness, young, _ = _component(track, component)
     mesh = unit_track(track)
     line = mesh.slab if component == 'slab' else mesh.base
@@ -245,7 +245,7 @@ def _grid(breaks: np.ndarray, size: float) -> np.ndarray:
     return np.concatenate(parts + [breaks[-1:]])
 
 
-def plate_mesh(component: str = 'slab', track: TrackConfig | None = None,
+def plate_mesh(component: str = 'slab', track: TrackParameters | None = None,
                element_size: float = ELEMENT_SIZE) -> tuple[PlateMesh, np.ndarray]:
     """
     Return the plate mesh of one unit and the beam node positions on it.
@@ -253,7 +253,7 @@ def plate_mesh(component: str = 'slab', track: TrackConfig | None = None,
     Grid lines pass through the beam nodes (slab ends, fasteners), the rail
     axes and the edges of the rail-seat patches.
     """
-    track = track or TrackConfig()
+    track = track or TrackParameters()
     width, _, _, _ = _component(track, component)
     x_nodes = beam_unit(component, False, track).x
     half = 0.5 * track.rail_foot_width
@@ -282,9 +282,9 @@ def _eig(k: np.ndarray | sp.spmatrix, m: np.ndarray | sp.spmatrix,
 
 
 def beam_modes(component: str = 'slab', on_layer: bool = False,
-               track: TrackConfig | None = None, f_max: float = 150.0) -> ModeSet:
+               track: TrackParameters | None = None, f_max: float = 150.0) -> ModeSet:
     """Return the modes of the pipeline's beam of one unit up to f_max."""
-    track = track or TrackConfig()
+    track = track or TrackParameters()
     width, _, _, _ = _component(track, component)
     unit = beam_unit(component, on_layer, track)
     f, v = _eig(unit.stiffness, unit.mass, f_max)
@@ -308,10 +308,10 @@ def _trapezoid(x: np.ndarray) -> np.ndarray:
 
 
 def plate_modes(component: str = 'slab', on_layer: bool = False,
-                track: TrackConfig | None = None, f_max: float = 150.0,
+                track: TrackParameters | None = None, f_max: float = 150.0,
                 element_size: float = ELEMENT_SIZE) -> ModeSet:
     """Return the modes of the Mindlin plate of one unit up to f_max."""
-    track = track or TrackConfig()
+    track = track or TrackParameters()
     width, _, _, link_index = _component(track, component)
     plate = plate_of(component, track)
     mesh, x_nodes = plate_mesh(component, track, element_size)
@@ -345,7 +345,7 @@ def _kind(shape: np.ndarray) -> str:
 
 
 def compare(component: str = 'slab', on_layer: bool = False,
-            track: TrackConfig | None = None, f_max: float = 150.0,
+            track: TrackParameters | None = None, f_max: float = 150.0,
             element_size: float = ELEMENT_SIZE) -> Comparison:
     """
     Pair the beam's and the plate's modes of one unit up to f_max.
@@ -356,7 +356,7 @@ def compare(component: str = 'slab', on_layer: bool = False,
         'slab' or 'base'.
     on_layer : bool
         Free-free (False) or on the unit's continuous layer over rigid ground.
-    track : TrackConfig, optional
+    track : TrackParameters, optional
         Track keys (defaults: [P] Tables 2 and 4).
     f_max : float
         Highest frequency considered (Hz). The plate is solved to 1.3 f_max so
@@ -399,7 +399,7 @@ def compare(component: str = 'slab', on_layer: bool = False,
 
 
 def rail_seat_receptance(frequencies: np.ndarray, fastener: int = 0, both_rails: bool = False,
-                         track: TrackConfig | None = None,
+                         track: TrackParameters | None = None,
                          element_size: float = ELEMENT_SIZE) -> tuple[np.ndarray, np.ndarray]:
     """
     Return the vertical rail-seat receptance of the slab on its layer (m/N).
@@ -418,7 +418,7 @@ def rail_seat_receptance(frequencies: np.ndarray, fastener: int = 0, both_rails:
         Fastener index within the unit.
     both_rails : bool
         Load both rail seats of the fastener (as a wheelset does) instead of one.
-    track : TrackConfig, optional
+    track : TrackParameters, optional
         Track keys.
     element_size : float
         Plate element size (m).
@@ -429,7 +429,7 @@ def rail_seat_receptance(frequencies: np.ndarray, fastener: int = 0, both_rails:
         Beam and plate receptance at each frequency.
 
     """
-    track = track or TrackConfig()
+    track = track or TrackParameters()
     unit = beam_unit('slab', True, track)
     x_seat = unit.x[1 + fastener]
     r = track.rail_semi_spacing
@@ -475,7 +475,7 @@ def format_comparison(comparison: Comparison) -> str:
     return '\n'.join(lines)
 
 
-def support_differences(frequencies: np.ndarray, track: TrackConfig | None = None,
+def support_differences(frequencies: np.ndarray, track: TrackParameters | None = None,
                         element_size: float = ELEMENT_SIZE) -> dict[str, np.ndarray]:
     """
     Return beam-over-plate differences of the rail-seat receptance, per fastener.
@@ -492,7 +492,7 @@ def support_differences(frequencies: np.ndarray, track: TrackConfig | None = Non
         (1 / k_f + H).
 
     """
-    track = track or TrackConfig()
+    track = track or TrackParameters()
     n_half = (track.fasteners_per_slab + 1) // 2
     slab, support = np.zeros((2, 2, n_half, len(frequencies)))
     soft = 1.0 / track.fastener_vertical_stiffness

@@ -37,7 +37,7 @@ from typing import Iterable, Sequence
 import numpy as np
 
 from ttb_sim.analysis.psd import level_change_frequency, peak_frequency, welch_psd
-from ttb_sim.config.scenario import load_scenario
+from ttb_sim.config import load_scenario
 from ttb_sim.sim.frames import Frame
 from ttb_sim.sim.simulation import Simulation
 from ttb_sim.validation.rows import Case, relative_row, Row

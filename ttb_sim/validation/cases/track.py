@@ -113,9 +113,8 @@ from scipy.linalg import eigh
 from scipy.optimize import minimize_scalar
 
 from ttb_sim.analysis.psd import peak_frequency
-from ttb_sim.config.scenario import load_scenario, Scenario
+from ttb_sim.config import load_scenario, Scenario
 from ttb_sim.model.track import approach_length
-from ttb_sim.sim.coupling.train_track import car_parameters
 from ttb_sim.sim.simulation import Simulation
 from ttb_sim.validation.references import track as tr
 from ttb_sim.validation.rows import Case, relative_row, Row
@@ -284,7 +283,7 @@ def v2_run(values: Sequence[tuple[str, Any]] = (), overrides: Sequence[str] = ()
     disp = -np.array(z)                                       # downward positive
     heads_a = np.array(heads)
     n = n_observers
-    p0 = car_parameters(scenario).static_wheel_load
+    p0 = scenario.car.static_wheel_load
     over = (heads_a - offsets[1] > x_bay - 2.0) & (heads_a - offsets[0] < x_bay + s + 2.0)
     deviation = float(np.max(np.abs(np.array(loads)[over] / p0 - 1.0)))
     ref = superposed_peak(offsets, p0, speed)

@@ -1,0 +1,253 @@
+# Copyright 2026 The ttb_sim Authors
+#
+# Licensed under the Apache License, Version 2.0 (the "License");
+# you may not use this file except in compliance with the License.
+# You may obtain a copy of the License at
+#
+#     http://www.apache.org/licenses/LICENSE-2.0
+#
+# Unless required by applicable law or agreed to in writing, software
+# distributed under the License is distributed on an "AS IS" BASIS,
+# WITHOUT WARRANTIES OR CONDITIONS OF ANY KIND, either express or implied.
+# See the License for the specific language governing permissions and
+# limitations under the License.
+
+"""
+The scenario records: one frozen dataclass per section, each key declared once.
+
+A scenario is a tree of these records (:class:`Scenario` at the root).  Every
+leaf is declared with :func:`~ttb_sim.parameters.param` (default, unit, range
+or choices, description); the car section is the model's own car record
+(:class:`~ttb_sim.model.vehicle.car.CarParameters`).  Rules that involve more
+than one key are checked when a :class:`Scenario` is made.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import dataclass, field
+import math
+import re
+from typing import Any, Sequence
+
+from ttb_sim.config.schema import to_plain
+from ttb_sim.errors import ScenarioError
+from ttb_sim.model.bridge import (BearingParameters, BridgeParameters, FoundationParameters,
+                                  PierParameters)
+from ttb_sim.model.track import TrackParameters
+from ttb_sim.model.vehicle.car import CarParameters
+from ttb_sim.parameters import param
+
+
+@dataclass(frozen=True)
+class TrainConfig:
+    """Train: vehicle model, axle layout and running speed."""
+
+    vehicle: str = param('moving_force', '-', 'Vehicle model: constant moving forces, '
+                         'quarter cars (a sprung mass on a spring-dashpot over each axle), or '
+                         "42-DOF multibody cars ([P] Table 1, section 'car') on wheel-rail "
+                         "contact (needs track.model = 'slab').",
+                         choices=('moving_force', 'sprung_mass', 'car'))
+    speed_kmh: float = param(300.0, 'km/h', 'Running speed of the train (the upper bound '
+                             'is a numerical guard: validation runs use high speed '
+                             'parameters).', low=0.0, high=10000.0, low_inclusive=False,
+                             dynamic=True)
+    start_position: float = param(0.0, 'm', 'Position of the train head along the track at '
+                                  't = 0 (0 is the start of the first span).',
+                                  low=-5000.0, high=5000.0)
+    axle_offsets: tuple[float, ...] = param((), 'm', 'Distances of the axles behind the train '
+                                            'head; empty = derived from the car geometry.',
+                                            low=0.0, high=5000.0)
+    n_cars: int = param(8, '-', 'Number of cars (when axle_offsets is empty).', low=1, high=32)
+    car_length: float = param(25.0, 'm', 'Length of one car over couplers.', low=1.0,
+                              high=60.0)
+    axle_load: float = param(156960.0, 'N', 'Magnitude of each moving force (moving_force '
+                             'vehicle); default = (Mc/4 + Mt/2 + Mw) g of [P] Table 1.',
+                             low=0.0, high=1e7)
+    sprung_mass: float = param(5750.0, 'kg', 'Sprung mass of each quarter car.', low=0.0,
+                               high=1e6, low_inclusive=False)
+    unsprung_mass: float = param(0.0, 'kg', 'Unsprung (wheel) mass of each quarter car, '
+                                 'which follows the girder; 0 = massless wheel.', low=0.0,
+                                 high=1e5)
+    suspension_stiffness: float = param(1.595e6, 'N/m', 'Suspension stiffness of each '
+                                        'quarter car.', low=0.0, high=1e12,
+                                        low_inclusive=False)
+    suspension_damping: float = param(0.0, 'N*s/m', 'Suspension damping of each quarter car.',
+                                      low=0.0, high=1e9)
+
+    @property
+    def speed(self) -> float:
+        """Return the running speed in m/s."""
+        return self.speed_kmh / 3.6
+
+
+@dataclass(frozen=True)
+class IrregularityConfig:
+    """Track irregularity (applied under quarter cars; moving forces ignore it)."""
+
+    spectrum: str = param('none', '-', "Irregularity spectrum ('paper' = Chinese HSR vertical "
+                          "and alignment 1-50 m plus Sato 0.05-1 m; 'chinese_sato' the same with "
+                          "1-200 m); 'none' is a smooth track.",
+                          choices=('none', 'paper', 'chinese_sato', 'chinese_hsr', 'sato',
+                                   'german_low',
+                                   'german_high', 'fra1', 'fra2', 'fra3', 'fra4', 'fra5',
+                                   'fra6'), dynamic=True)
+    seed: int = param(1, '-', 'Seed of the random phases (same seed, same track).', low=0,
+                      high=2**31 - 1, dynamic=True)
+    scale: float = param(1.0, '-', 'Factor on the irregularity amplitude; 0 gives a smooth '
+                         'track.', low=0.0, high=100.0, dynamic=True)
+    file: str = param('', '-', 'CSV of a measured profile (x, z_left, z_right, y_left, '
+                      'y_right in metres; smooth outside its range); empty = synthesise '
+                      'from the spectrum.', dynamic=True)
+    grid_spacing: float = param(0.01, 'm', 'Grid spacing of the synthesised profile (must be '
+                                'under half the shortest wavelength).', low=0.001, high=1.0)
+
+
+@dataclass(frozen=True)
+class ContactConfig:
+    """Wheel-rail contact of multibody cars (PHYSICS.md section 2)."""
+
+    tread: str = param('lm', '-', "Zhai's Hertz constant: worn 'lm' or 'conical' tread.",
+                       choices=('lm', 'conical'))
+    friction: float = param(0.3, '-', 'Friction coefficient of the Shen-Hedrick-Elkins '
+                            'saturation.', low=0.0, high=1.0, low_inclusive=False)
+    geometry: str = param('profiles', '-', "'profiles': LMA wheel on CHN60 rail contact "
+                          "table; 'conicity': equivalent cone.",
+                          choices=('profiles', 'conicity'))
+    conicity: float = param(0.05, '-', "Equivalent conicity for geometry = 'conicity'.",
+                            low=0.0, high=1.0)
+    tolerance: float = param(1e-9, 'm', 'Convergence tolerance of the contact iteration on '
+                             'the compression of every wheel.', low=1e-15, high=1e-3,
+                             low_inclusive=False)
+    max_iterations: int = param(30, '-', 'Contact iterations per step before the run stops '
+                                'as diverged.', low=1, high=1000)
+
+
+@dataclass(frozen=True)
+class SolverConfig:
+    """Time integration (Newmark average acceleration)."""
+
+    dt: float = param(0.0, 's', 'Time step; 0 picks it automatically (see README).', low=0.0,
+                      high=0.1)
+    duration: float = param(0.0, 's', 'Simulated time; 0 runs until the last axle has left '
+                            'the bridge plus free_vibration_periods fundamental periods.',
+                            low=0.0, high=1e5)
+    free_vibration_periods: float = param(1.0, '-', 'Fundamental periods of free vibration '
+                                          'appended to an automatic duration.', low=0.0,
+                                          high=1000.0)
+    divergence_limit: float = param(10.0, 'm', 'Any displacement larger than this (or not '
+                                    'finite) stops the run as diverged.', low=0.0, high=1e6,
+                                    low_inclusive=False)
+
+
+@dataclass(frozen=True)
+class OutputConfig:
+    """What is written, and how often."""
+
+    rate_hz: float = param(0.0, 'Hz', 'Frame (message) rate in simulation time; 0 = every '
+                           'solver step. Rounded so that frames fall on solver steps.',
+                           low=0.0, high=1e6)
+    observers: tuple[str, ...] = param((), '-', 'Named displacement observers, each '
+                                       "'name=component@x' with component rail_left, "
+                                       'rail_right, slab, base or girder and x the position '
+                                       'along the track (m); published on ~/observers/name.')
+
+
+@dataclass(frozen=True)
+class Scenario:
+    """A complete simulation case."""
+
+    name: str = param('custom', '-', 'Short name of the scenario.')
+    description: str = param('', '-', 'One line describing the scenario.')
+    train: TrainConfig = field(default_factory=TrainConfig)
+    car: CarParameters = field(default_factory=CarParameters)
+    track: TrackParameters = field(default_factory=TrackParameters)
+    contact: ContactConfig = field(default_factory=ContactConfig)
+    bridge: BridgeParameters = field(default_factory=BridgeParameters)
+    bearings: BearingParameters = field(default_factory=BearingParameters)
+    piers: PierParameters = field(default_factory=PierParameters)
+    foundation: FoundationParameters = field(default_factory=FoundationParameters)
+    irregularity: IrregularityConfig = field(default_factory=IrregularityConfig)
+    solver: SolverConfig = field(default_factory=SolverConfig)
+    output: OutputConfig = field(default_factory=OutputConfig)
+
+    def __post_init__(self) -> None:
+        """Check the rules that involve more than one key."""
+        _check_consistency(self)
+
+    def axle_positions(self) -> tuple[float, ...]:
+        """Distances of all axles behind the head (m): ``train.axle_offsets`` or the car layout."""
+        if self.train.axle_offsets:
+            return tuple(float(a) for a in self.train.axle_offsets)
+        lc, lt = self.car.bogie_semi_spacing, self.car.wheelbase_semi
+        length = self.train.car_length
+        first = length / 2.0 - lc - lt
+        local = (first, first + 2 * lt, first + 2 * lc, first + 2 * lc + 2 * lt)
+        return tuple(k * length + a for k in range(self.train.n_cars) for a in local)
+
+    def to_dict(self) -> dict[str, Any]:
+        """Return the scenario as plain nested dicts (for echo in summaries)."""
+        return to_plain(dataclasses.asdict(self))
+
+
+def _check_consistency(s: Scenario) -> None:
+    if s.bridge.elements_per_span % 2:
+        raise ScenarioError(f'bridge.elements_per_span = {s.bridge.elements_per_span}: must be '
+                            'even, so that a node sits at mid-span')
+    if s.foundation.model == 'springs' and s.bearings.model == 'rigid':
+        raise ScenarioError("foundation.model = 'springs' needs bearings.model = 'elastic' "
+                            '(rigid bearings model ideal fixed supports)')
+    if s.train.vehicle == 'car' and s.track.model != 'slab':
+        raise ScenarioError(f"train.vehicle = 'car' needs track.model = 'slab' (got "
+                            f'{s.track.model!r}): wheels run on rails')
+    if s.track.model == 'slab' and s.train.vehicle != 'car':
+        raise ScenarioError(f"track.model = 'slab' needs train.vehicle = 'car' (got "
+                            f'{s.train.vehicle!r})')
+    parse_observers(s.output.observers)
+
+
+OBSERVER_COMPONENTS = ('rail_left', 'rail_right', 'slab', 'base', 'girder')
+_OBSERVER = re.compile(r'^([A-Za-z][A-Za-z0-9_]*)=([a-z_]+)@(.+)$')
+
+
+@dataclass(frozen=True)
+class Observer:
+    """A named displacement observation point (``output.observers``)."""
+
+    name: str
+    component: str
+    x: float
+
+
+def parse_observers(entries: Sequence[str]) -> tuple[Observer, ...]:
+    """
+    Parse ``output.observers`` entries of the form ``name=component@x``.
+
+    Raises
+    ------
+    ScenarioError
+        Naming the entry and what is allowed, for a malformed entry, an unknown
+        component, a non-finite position or a repeated name.
+
+    """
+    out: list[Observer] = []
+    for i, entry in enumerate(entries):
+        path = f'output.observers[{i}] = {entry!r}'
+        match = _OBSERVER.match(entry.strip())
+        if not match:
+            raise ScenarioError(f"{path}: expected 'name=component@x' with a name of "
+                                'letters, digits and _ (starting with a letter)')
+        name, component, x_text = match.groups()
+        if component not in OBSERVER_COMPONENTS:
+            raise ScenarioError(f'{path}: component {component!r} is unknown; allowed: '
+                                f'{", ".join(OBSERVER_COMPONENTS)}')
+        try:
+            x = float(x_text)
+        except ValueError:
+            x = math.nan
+        if not math.isfinite(x):
+            raise ScenarioError(f'{path}: position {x_text!r} is not a finite number (m)')
+        if any(o.name == name for o in out):
+            raise ScenarioError(f'{path}: observer name {name!r} is used twice')
+        out.append(Observer(name, component, x))
+    return tuple(out)

@@ -1,0 +1,188 @@
+# Copyright 2026 The ttb_sim Authors
+#
+# Licensed under the Apache License, Version 2.0 (the "License");
+# you may not use this file except in compliance with the License.
+# You may obtain a copy of the License at
+#
+#     http://www.apache.org/licenses/LICENSE-2.0
+#
+# Unless required by applicable law or agreed to in writing, software
+# distributed under the License is distributed on an "AS IS" BASIS,
+# WITHOUT WARRANTIES OR CONDITIONS OF ANY KIND, either express or implied.
+# See the License for the specific language governing permissions and
+# limitations under the License.
+
+"""
+The schema walker: every declared key of the scenario tree, and typed, range-checked values.
+
+:func:`iter_keys` and :func:`key_spec` walk the :func:`~ttb_sim.parameters.param`
+declarations of the scenario records; :func:`from_mapping` builds the record
+tree from plain (YAML) data, checking each value against its declaration and
+naming the key path, the value and what is allowed when it refuses.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import sys
+from typing import Any, Iterator, Mapping
+
+from ttb_sim.errors import ModelError, ScenarioError
+from ttb_sim.parameters import Spec
+
+__all__ = ['from_mapping', 'iter_keys', 'key_spec', 'to_plain']
+
+
+# --------------------------------------------------------------------------------------
+# Key walking
+# --------------------------------------------------------------------------------------
+
+def iter_keys(cls: type | None = None, prefix: str = '') -> Iterator[tuple[str, type, Any, Spec]]:
+    """
+    Yield every leaf key of the schema.
+
+    Yields
+    ------
+    tuple
+        (dotted key path, Python type, default, spec) for each leaf.
+
+    """
+    cls = _root(cls)
+    hints = _hints(cls)
+    for f in dataclasses.fields(cls):
+        path = f'{prefix}{f.name}'
+        if 'spec' in f.metadata:
+            yield path, hints[f.name], f.default, f.metadata['spec']
+        else:
+            yield from iter_keys(hints[f.name], prefix=f'{path}.')
+
+
+def key_spec(path: str) -> tuple[type, Any, Spec]:
+    """
+    Return (type, default, spec) of one dotted key.
+
+    Raises
+    ------
+    ScenarioError
+        If the key does not exist.
+
+    """
+    for key, typ, default, spec in iter_keys():
+        if key == path:
+            return typ, default, spec
+    raise ScenarioError(f'unknown key {path!r}; see `ttb-sim scenarios --keys` for the list')
+
+
+def _root(cls: type | None) -> type:
+    """Return ``cls``, or the scenario root record when it is None."""
+    if cls is not None:
+        return cls
+    from ttb_sim.config.records import Scenario  # the records import this module
+    return Scenario
+
+
+def _hints(cls: type) -> dict[str, Any]:
+    module = sys.modules[cls.__module__]
+    out = {}
+    for f in dataclasses.fields(cls):
+        t = f.type
+        out[f.name] = eval(t, vars(module)) if isinstance(t, str) else t  # noqa: S307
+    return out
+
+
+# --------------------------------------------------------------------------------------
+# Building from plain data
+# --------------------------------------------------------------------------------------
+
+def from_mapping(data: Mapping[str, Any], cls: type | None = None, prefix: str = '') -> Any:
+    """
+    Build a (nested) config dataclass from plain data, validating every key.
+
+    Raises
+    ------
+    ScenarioError
+        On an unknown key, a wrong type or a value out of range; the message
+        names the key path, the value and what is allowed.
+
+    """
+    cls = _root(cls)
+    if not isinstance(data, Mapping):
+        where = prefix[:-1] or 'the scenario'
+        raise ScenarioError(f'{where} must be a mapping of keys, got {data!r}')
+    hints = _hints(cls)
+    names = {f.name: f for f in dataclasses.fields(cls)}
+    kwargs: dict[str, Any] = {}
+    for key, value in data.items():
+        path = f'{prefix}{key}'
+        if key not in names:
+            allowed = ', '.join(sorted(names))
+            raise ScenarioError(f'unknown key {path!r}; allowed here: {allowed}')
+        f = names[key]
+        if 'spec' in f.metadata:
+            kwargs[key] = _coerce(path, value, hints[key], f.metadata['spec'])
+        else:
+            kwargs[key] = from_mapping(value, hints[key], prefix=f'{path}.')
+    try:
+        return cls(**kwargs)
+    except ScenarioError:
+        raise
+    except ModelError as exc:  # a record's own cross-field check
+        raise ScenarioError(f'{prefix[:-1] or "scenario"}: {exc}') from None
+    except (TypeError, ValueError) as exc:  # pragma: no cover - defensive
+        raise ScenarioError(f'{prefix[:-1] or "scenario"}: {exc}') from None
+
+
+def _coerce(path: str, value: Any, typ: Any, spec: Spec) -> Any:
+    """Check one value against its declared type and range, and return it typed."""
+    if typ in (tuple[float, ...],):
+        if not isinstance(value, (list, tuple)):
+            raise ScenarioError(f'{path} = {value!r}: expected a list of numbers ({spec.unit})')
+        items = tuple(_coerce_number(f'{path}[{i}]', v, float, spec)
+                      for i, v in enumerate(value))
+        return items
+    if typ in (tuple[str, ...],):
+        if not isinstance(value, (list, tuple)) or not all(isinstance(v, str) for v in value):
+            raise ScenarioError(f'{path} = {value!r}: expected a list of strings')
+        return tuple(value)
+    if typ is bool:
+        if not isinstance(value, bool):
+            raise ScenarioError(f'{path} = {value!r}: expected true or false')
+        return value
+    if typ is str:
+        if not isinstance(value, str):
+            raise ScenarioError(f'{path} = {value!r}: expected a string, {spec.allowed()}')
+        if spec.choices is not None and value not in spec.choices:
+            raise ScenarioError(f'{path} = {value!r}: allowed values are {spec.allowed()}')
+        return value
+    if typ in (float, int):
+        return _coerce_number(path, value, typ, spec)
+    raise TypeError(f'unsupported schema type {typ!r} for {path}')  # pragma: no cover
+
+
+def _coerce_number(path: str, value: Any, typ: type, spec: Spec) -> float | int:
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        kind = 'an integer' if typ is int else 'a number'
+        raise ScenarioError(f'{path} = {value!r}: expected {kind}, allowed {spec.allowed()}')
+    if typ is int:
+        if isinstance(value, float):
+            if not value.is_integer():
+                raise ScenarioError(f'{path} = {value!r}: expected an integer, allowed '
+                                    f'{spec.allowed()}')
+        value = int(value)
+    else:
+        value = float(value)
+        if not math.isfinite(value):
+            raise ScenarioError(f'{path} = {value!r}: expected a finite number, allowed '
+                                f'{spec.allowed()}')
+    if not spec.contains(value):
+        raise ScenarioError(f'{path} = {value!r} is out of range: allowed {spec.allowed()}')
+    return value
+
+
+def to_plain(value: Any) -> Any:
+    if isinstance(value, dict):
+        return {k: to_plain(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [to_plain(v) for v in value]
+    return value
