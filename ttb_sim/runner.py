@@ -31,12 +31,15 @@ from typing import Any, Callable
 
 from ttb_sim import __version__
 from ttb_sim.errors import DivergenceError
-from ttb_sim.io.bag import BagRecorder, check_destination
+from ttb_sim.io.bag import BagRecorder, check_destination, default_bag_path
 from ttb_sim.io.topics import PeakTracker, topic_table
 from ttb_sim.scenario import Scenario
 from ttb_sim.sim.simulation import Simulation
 
 log = logging.getLogger(__name__)
+
+default_output = default_bag_path
+"""New bag directory under ``./runs`` for a scenario name (kept here for ``cli.py``)."""
 
 
 @dataclass
@@ -47,16 +50,6 @@ class RunResult:
     status: str
     """'ok', 'diverged' or 'interrupted'."""
     summary: dict[str, Any]
-
-
-def default_output(name: str, root: Path = Path('runs')) -> Path:
-    """Return a new folder name under ``root`` for a scenario name."""
-    stem = root / f'{name}-{time.strftime("%Y%m%d-%H%M%S")}'
-    path, k = stem, 1
-    while path.exists():
-        k += 1
-        path = stem.with_name(f'{stem.name}-{k}')
-    return path
 
 
 def run_to_bag(scenario: Scenario, out: Path, storage: str = 'mcap',

@@ -62,12 +62,11 @@ from rosidl_runtime_py.utilities import get_message
 from std_msgs.msg import ColorRGBA, Header
 from std_srvs.srv import SetBool, Trigger
 from ttb_sim.errors import ScenarioError
-from ttb_sim.io.bag import BagRecorder
+from ttb_sim.io.bag import BagRecorder, default_bag_path
 from ttb_sim.io.topics import FRAME_ID, topic_table
 from ttb_sim.node_logic import (DEFAULT_SCENARIO, initial_values, markers, MarkerSet,
                                 NodeParameter, parameter_table, PassageController,
                                 validate_changes)
-from ttb_sim.runner import default_output
 from ttb_sim.scenario import load_scenario
 from visualization_msgs.msg import Marker, MarkerArray
 
@@ -189,7 +188,7 @@ class SimulatorNode(Node):
         self.topics = topic_table(self.controller.layout)
         if values['bag.enabled']:
             path = Path(values['bag.path']) if values['bag.path'] else \
-                default_output(scenario.name)
+                default_bag_path(scenario.name)
             path.parent.mkdir(parents=True, exist_ok=True)
             # Nothing has been stepped yet, so the bag gets every frame from t = 0.
             self.controller.recorder = BagRecorder(path, self.topics, values['bag.storage'],
