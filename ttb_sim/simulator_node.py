@@ -15,9 +15,9 @@
 """
 The ROS 2 simulator node ``ttb_sim`` (``ros2 run ttb_sim simulator``).
 
-A thin rclpy shell over :mod:`ttb_sim.node_logic`: it declares the parameters
-of :func:`~ttb_sim.node_logic.parameter_table`, forwards parameter changes and
-service calls to a :class:`~ttb_sim.node_logic.PassageController`, and copies
+A thin rclpy shell over :mod:`ttb_sim.node.passage`: it declares the parameters
+of :func:`~ttb_sim.node.passage.parameter_table`, forwards parameter changes and
+service calls to a :class:`~ttb_sim.node.passage.PassageController`, and copies
 the controller's frames, diagnostics and markers into standard messages.
 
 Publishers and their QoS (all explicit):
@@ -64,9 +64,9 @@ from std_srvs.srv import SetBool, Trigger
 from ttb_sim.errors import ScenarioError
 from ttb_sim.io.bag import BagRecorder, default_bag_path
 from ttb_sim.io.topics import FRAME_ID, topic_table
-from ttb_sim.node_logic import (DEFAULT_SCENARIO, initial_values, markers, MarkerSet,
-                                NodeParameter, parameter_table, PassageController,
-                                validate_changes)
+from ttb_sim.node.passage import (DEFAULT_SCENARIO, initial_values, markers, MarkerSet,
+                                  NodeParameter, parameter_table, PassageController,
+                                  validate_changes)
 from ttb_sim.scenario import load_scenario
 from visualization_msgs.msg import Marker, MarkerArray
 

@@ -24,9 +24,9 @@ from rosbags.highlevel import AnyReader
 from ttb_sim.errors import ScenarioError
 from ttb_sim.io.bag import BagRecorder
 from ttb_sim.io.topics import topic_table
-from ttb_sim.node_logic import (ERROR, initial_values, markers, model_markers, OK,
-                                parameter_table, PassageController, SCENARIO_KEYS,
-                                train_markers, validate_changes, validate_parameter)
+from ttb_sim.node.passage import (ERROR, initial_values, markers, model_markers, OK,
+                                  parameter_table, PassageController, SCENARIO_KEYS,
+                                  train_markers, validate_changes, validate_parameter)
 from ttb_sim.scenario import key_spec, load_scenario, Scenario
 from ttb_sim.sim.frames import Frame
 
