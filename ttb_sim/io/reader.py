@@ -238,8 +238,9 @@ def read_bag(path: str | Path, topics: Iterable[str] | None = None) -> dict[str,
         raw: dict[str, list[bytes]] = defaultdict(list)
         received: dict[str, list[int]] = defaultdict(list)
         connections = [c for c in reader.connections if c.topic in wanted]
-        try:
-            for conn, timestamp, data in reader.messages(connections=connections):
+        try:   # (an empty connection list would mean every connection to rosbags)
+            for conn, timestamp, data in (reader.messages(connections=connections)
+                                          if connections else ()):
                 raw[conn.topic].append(data)
                 received[conn.topic].append(timestamp)
         except ReaderError as exc:
