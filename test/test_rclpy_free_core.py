@@ -99,7 +99,7 @@ def test_core_modules_import_with_ros_blocked() -> None:
     for name in ROS_ONLY:   # control: the hook does stop the rclpy shell
         assert results[name]['status'].startswith('ros'), (name, results[name])
         del results[name]
-    for name in ('ttb_sim.node_logic', 'ttb_sim.io.topics', 'ttb_sim.io.bag',
+    for name in ('ttb_sim.node', 'ttb_sim.io.topics', 'ttb_sim.io.bag',
                  'ttb_sim.sim.simulation', 'ttb_sim.config', 'ttb_sim.cli'):
         assert results[name]['status'] == 'ok', (name, results[name])
     ros = {name: r for name, r in results.items()

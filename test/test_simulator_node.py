@@ -30,7 +30,7 @@ import pytest
 
 rclpy = pytest.importorskip(
     'rclpy', reason='rclpy is not importable: source a ROS 2 Jazzy installation to run the '
-    'node tests (the ROS-free node logic is tested in test_node_logic.py)')
+    'node tests (the ROS-free node logic is tested in test/node/)')
 
 from nav_msgs.msg import Odometry  # noqa: E402, I100
 from rcl_interfaces.msg import Parameter as ParameterMsg  # noqa: E402

@@ -39,3 +39,7 @@ class SimulationError(TtbSimError, RuntimeError):
 
 class DivergenceError(SimulationError):
     """The solution became non-finite or exceeded its divergence limit (exit code 1)."""
+
+
+class BagError(ScenarioError):
+    """A bag to read is missing, not a bag, truncated or lacks a topic (exit code 2)."""

@@ -15,9 +15,9 @@
 """
 The ROS 2 simulator node ``ttb_sim`` (``ros2 run ttb_sim simulator``).
 
-A thin rclpy shell over :mod:`ttb_sim.node_logic`: it declares the parameters
-of :func:`~ttb_sim.node_logic.parameter_table`, forwards parameter changes and
-service calls to a :class:`~ttb_sim.node_logic.PassageController`, and copies
+A thin rclpy shell over the ROS-free :mod:`ttb_sim.node`: it declares the parameters
+of :func:`~ttb_sim.node.parameters.parameter_table`, forwards parameter changes and
+service calls to a :class:`~ttb_sim.node.passage.PassageController`, and copies
 the controller's frames, diagnostics and markers into standard messages.
 
 Publishers and their QoS (all explicit):
@@ -61,14 +61,12 @@ from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPo
 from rosidl_runtime_py.utilities import get_message
 from std_msgs.msg import ColorRGBA, Header
 from std_srvs.srv import SetBool, Trigger
-from ttb_sim.commands.run import default_output
 from ttb_sim.config import load_scenario
 from ttb_sim.errors import ScenarioError
-from ttb_sim.io.bag import BagRecorder
+from ttb_sim.io.bag import BagRecorder, default_bag_path
 from ttb_sim.io.topics import FRAME_ID, topic_table
-from ttb_sim.node_logic import (DEFAULT_SCENARIO, initial_values, markers, MarkerSet,
-                                NodeParameter, parameter_table, PassageController,
-                                validate_changes)
+from ttb_sim.node import (DEFAULT_SCENARIO, initial_values, markers, MarkerSet, NodeParameter,
+                          parameter_table, PassageController, validate_changes)
 from visualization_msgs.msg import Marker, MarkerArray
 
 STEP_PERIOD = 0.01
@@ -162,6 +160,13 @@ class SimulatorNode(Node):
             self.destroy_node()
             raise
 
+    @property
+    def _controller(self) -> PassageController:
+        """The passage controller; set by the constructor (callbacks run only after it)."""
+        if self.controller is None:
+            raise RuntimeError('the ttb_sim node is not configured')
+        return self.controller
+
     # -- set-up -------------------------------------------------------------------------
 
     def _configure(self) -> None:
@@ -189,7 +194,7 @@ class SimulatorNode(Node):
         self.topics = topic_table(self.controller.layout)
         if values['bag.enabled']:
             path = Path(values['bag.path']) if values['bag.path'] else \
-                default_output(scenario.name)
+                default_bag_path(scenario.name)
             path.parent.mkdir(parents=True, exist_ok=True)
             # Nothing has been stepped yet, so the bag gets every frame from t = 0.
             self.controller.recorder = BagRecorder(path, self.topics, values['bag.storage'],
@@ -242,36 +247,36 @@ class SimulatorNode(Node):
     def _post_set(self, parameters: list[Parameter]) -> None:
         """Apply accepted values to the running simulation."""
         for p in parameters:
-            self.controller.apply(p.name, p.value)
+            self._controller.apply(p.name, p.value)
             self.get_logger().info(f'{p.name} = {p.value!r}')
 
     # -- services -----------------------------------------------------------------------
 
     def _on_reset(self, request: Trigger.Request,
                   response: Trigger.Response) -> Trigger.Response:
-        response.message = self.controller.reset()
+        response.message = self._controller.reset()
         response.success = True
         return response
 
     def _on_pause(self, request: SetBool.Request,
                   response: SetBool.Response) -> SetBool.Response:
-        response.message = self.controller.set_paused(bool(request.data))
-        response.success = self.controller.state in ('paused', 'running')
+        response.message = self._controller.set_paused(bool(request.data))
+        response.success = self._controller.state in ('paused', 'running')
         return response
 
     # -- stepping and publishing --------------------------------------------------------
 
     def _on_step(self) -> None:
-        tick = self.controller.advance(budget=STEP_BUDGET)
+        tick = self._controller.advance(budget=STEP_BUDGET)
         if 'diverged' in tick.events:
-            self.get_logger().error(f'{self.controller.divergence}; stepping stopped, bag '
+            self.get_logger().error(f'{self._controller.divergence}; stepping stopped, bag '
                                     'closed; call ~/reset to restart')
         if 'idle' in tick.events:
             self.get_logger().info('the train has left: idle (set loop:=true or call '
                                    '~/reset for another passage)')
         if not tick.frames or not self.context.ok():
             return
-        clock = self.controller.values['publish_clock']
+        clock = self._controller.values['publish_clock']
         try:
             for frame in tick.frames:
                 for topic in self.topics:
@@ -287,10 +292,10 @@ class SimulatorNode(Node):
             self.get_logger().debug(f'publishing stopped at shutdown: {exc}')
 
     def _publish_markers(self, head_position: float) -> None:
-        self.markers_pub.publish(marker_array(markers(self.controller.base, head_position)))
+        self.markers_pub.publish(marker_array(markers(self._controller.base, head_position)))
 
     def _on_diagnostics(self) -> None:
-        report = self.controller.diagnostics()
+        report = self._controller.diagnostics()
         status = DiagnosticStatus(level=bytes([report.level]), name='ttb_sim: simulation',
                                   message=report.message, hardware_id=self.get_name(),
                                   values=[KeyValue(key=k, value=v) for k, v in report.values])

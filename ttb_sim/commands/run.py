@@ -34,7 +34,7 @@ from typing import Any, Callable, Sequence
 from ttb_sim import __version__
 from ttb_sim.config import load_scenario, Scenario
 from ttb_sim.errors import DivergenceError
-from ttb_sim.io.bag import BagRecorder, check_destination
+from ttb_sim.io.bag import BagRecorder, check_destination, default_bag_path
 from ttb_sim.io.topics import PeakTracker, topic_table
 from ttb_sim.sim.simulation import Simulation
 
@@ -64,16 +64,6 @@ class RunResult:
     status: str
     """'ok', 'diverged' or 'interrupted'."""
     summary: dict[str, Any]
-
-
-def default_output(name: str, root: Path = Path('runs')) -> Path:
-    """Return a new folder name under ``root`` for a scenario name."""
-    stem = root / f'{name}-{time.strftime("%Y%m%d-%H%M%S")}'
-    path, k = stem, 1
-    while path.exists():
-        k += 1
-        path = stem.with_name(f'{stem.name}-{k}')
-    return path
 
 
 def run_to_bag(scenario: Scenario, out: Path, storage: str = 'mcap',
@@ -194,7 +184,7 @@ def run(scenario: str | Path, *, out: Path | None = None, storage: str = 'mcap',
         values.append(('solver.duration', duration))
     loaded = load_scenario(scenario, overrides, values)
     simulation = Simulation(loaded)
-    out = out if out is not None else default_output(loaded.name)
+    out = out if out is not None else default_bag_path(loaded.name)
     bar = None
     if sys.stderr.isatty():
         from tqdm import tqdm

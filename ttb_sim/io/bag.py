@@ -17,6 +17,7 @@
 from __future__ import annotations
 
 from pathlib import Path
+import time
 from types import TracebackType
 from typing import Any, Sequence
 
@@ -46,6 +47,34 @@ def check_destination(path: str | Path, storage: str) -> None:
     if Path(path).exists():
         raise ScenarioError(f'output directory {str(path)!r} exists; refusing to overwrite it '
                             '(choose another --out)')
+
+
+def default_bag_path(name: str, root: Path = Path('runs')) -> Path:
+    """
+    Return a new bag directory for a scenario name: ``root/<name>-<YYYYmmdd-HHMMSS>``.
+
+    A suffix ``-2``, ``-3``, ... is added when that directory exists already.
+    Nothing is created.
+
+    Parameters
+    ----------
+    name : str
+        Scenario name.
+    root : Path
+        Folder that holds the runs (``./runs`` by default).
+
+    Returns
+    -------
+    Path
+        A path that does not exist (at the time of the call).
+
+    """
+    stem = root / f'{name}-{time.strftime("%Y%m%d-%H%M%S")}'
+    path, k = stem, 1
+    while path.exists():
+        k += 1
+        path = stem.with_name(f'{stem.name}-{k}')
+    return path
 
 
 def typestore() -> Any:

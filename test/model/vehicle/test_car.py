@@ -236,8 +236,8 @@ def test_damping_ratio_limits():
     Secondary-only estimate (PHYSICS.md 3.1): zeta = 4 C_sz / (2 sqrt(4 K_sz Mc))
     = 0.707 (tolerance 1 %).  The projected ratios scale with the damper counts.
     """
-    per_spring = dict(primary_vertical_dampers=8, secondary_vertical_dampers=4,
-                      secondary_lateral_dampers=4)  # one damper per spring position
+    per_spring = {'primary_vertical_dampers': 8, 'secondary_vertical_dampers': 4,
+                  'secondary_lateral_dampers': 4}  # one damper per spring position
     stiff_primary = car.CarParameters(primary_stiffness_z=1e12, **per_spring)
     m, c, k = (car.mass_matrix(stiff_primary), car.damping_matrix(stiff_primary),
                car.stiffness_matrix(stiff_primary))

@@ -732,7 +732,7 @@ def contact_spring_stiffness(cmap: ContactMap, vertical: float, lateral: float =
                         ('longitudinal', longitudinal)):
         if not (math.isfinite(value) and value >= 0.0):
             raise ModelError(f'contact spring {name} = {value!r} N/m is invalid; '
-                                'allowed: finite and >= 0')
+                             'allowed: finite and >= 0')
     return (vertical * cmap.hz.T @ cmap.hz + lateral * cmap.hy.T @ cmap.hy
             + longitudinal * cmap.hx.T @ cmap.hx)
 

@@ -12,27 +12,18 @@
 # See the License for the specific language governing permissions and
 # limitations under the License.
 
+
 """
-The ROS-free logic of the simulator node.
+Passage control: the simulation stepping behind the live node, paced and recorded.
 
-Everything the node decides lives here, so that it is tested where ROS 2 is
-absent; :mod:`ttb_sim.simulator_node` only copies values into rclpy objects.
-
-- :func:`parameter_table` derives the node's parameters from the scenario
-  schema (:func:`ttb_sim.config.scenario.key_spec`), adding a few node-only ones.
-- :func:`validate_parameter` checks one proposed value and returns
-  ``(ok, reason)``; the reason names the parameter, the value and what is allowed.
-- :class:`PassageController` owns a :class:`~ttb_sim.sim.simulation.Simulation`,
-  steps it paced by the real-time factor, hands every frame to a recorder and
-  the frames due for live publishing (``publish_rate_hz`` of simulation time)
-  to the caller, and handles speed changes, reset, pause, loop and divergence.
-- :func:`model_markers` / :func:`train_markers` describe the RViz markers as
-  plain data.
-
-Irregularity parameters (``irregularity.*``) are validated and stored when set;
-they apply from the next passage (a loop restart or a reset), because the track
-irregularity of a passage is generated when the passage starts. The speed
-(``train.speed_kmh``) applies at the next solver step.
+:class:`PassageController` owns a :class:`~ttb_sim.sim.simulation.Simulation`,
+steps it paced by the real-time factor, hands every frame to a recorder (a
+:class:`FrameSink`) and the frames due for live publishing (``publish_rate_hz``
+of simulation time) to the caller as a :class:`Tick`, and handles speed
+changes, reset, pause, loop and divergence. :meth:`PassageController.diagnostics`
+reports solver health as a :class:`DiagnosticsReport` (plain data that the node
+copies into ``/diagnostics``); :func:`frame_values` gives a frame's headline
+values for it.
 """
 
 from __future__ import annotations
@@ -40,28 +31,18 @@ from __future__ import annotations
 from dataclasses import dataclass, field, replace
 import logging
 import math
-from pathlib import Path
 import threading
 import time
 from typing import Any, Callable, Iterator, Mapping, Protocol
 
-from ttb_sim.config import apply_overrides, from_mapping, key_spec, Scenario, Spec
-from ttb_sim.errors import DivergenceError, ScenarioError, TtbSimError
-from ttb_sim.io.bag import STORAGES
-from ttb_sim.io.topics import FRAME_ID
+from ttb_sim.config import Scenario
+from ttb_sim.errors import DivergenceError, TtbSimError
+from ttb_sim.node.parameters import (IRREGULARITY_KEYS, normalize_value, parameter_table,
+                                     SCENARIO_KEYS, scenario_with)
 from ttb_sim.sim.frames import Frame, Layout
 from ttb_sim.sim.simulation import Simulation
 
 log = logging.getLogger(__name__)
-
-DEFAULT_SCENARIO = 'moving_force_beam'
-"""Scenario loaded when the ``scenario`` parameter is not given."""
-
-SCENARIO_KEYS = ('train.speed_kmh', 'irregularity.spectrum', 'irregularity.seed',
-                 'irregularity.file', 'irregularity.scale')
-"""Node parameters that are scenario keys (same name, unit, range and description)."""
-
-IRREGULARITY_KEYS = tuple(k for k in SCENARIO_KEYS if k.startswith('irregularity.'))
 
 MARKER_PERIOD = 0.1
 """Wall-clock seconds between two marker updates of the moving train."""
@@ -69,279 +50,6 @@ MARKER_PERIOD = 0.1
 MAX_LAG = 0.5
 """Wall-clock seconds the stepping may fall behind its pace before the pace is re-anchored."""
 
-
-# --------------------------------------------------------------------------------------
-# Parameter table
-# --------------------------------------------------------------------------------------
-
-@dataclass(frozen=True)
-class NodeParameter:
-    """
-    One parameter of the node, as declared to ROS.
-
-    Attributes
-    ----------
-    name : str
-        Parameter name (dotted, as in the scenario schema).
-    kind : str
-        ROS parameter type: 'bool', 'integer', 'double' or 'string'.
-    default : Any
-        Declared default value.
-    spec : Spec
-        Unit, range or choices and description (shared with the scenario schema).
-    read_only : bool
-        True for structural parameters, fixed for the life of the node.
-    applies : str
-        When a change takes effect: 'immediately', 'next passage' or 'restart'.
-    scenario_key : str or None
-        The scenario key this parameter sets, if any.
-
-    """
-
-    name: str
-    kind: str
-    default: Any
-    spec: Spec
-    read_only: bool = False
-    applies: str = 'immediately'
-    scenario_key: str | None = None
-
-    @property
-    def accepts_integer(self) -> bool:
-        """Tell whether an integer value is accepted (double parameters: ``350`` = 350.0)."""
-        return self.kind == 'double'
-
-    @property
-    def unit(self) -> str:
-        """Unit of the value ('-' when dimensionless)."""
-        return self.spec.unit
-
-    def allowed(self) -> str:
-        """Describe the allowed values in words."""
-        if self.kind == 'bool':
-            return 'true or false'
-        if self.kind == 'string' and self.spec.choices is None:
-            return 'any string'
-        return self.spec.allowed()
-
-    def description(self) -> str:
-        """Return the description shown by ``ros2 param describe`` (with unit and range)."""
-        unit = self.unit if self.unit not in ('', '-') else 'dimensionless'
-        if self.kind in ('bool', 'string'):
-            unit_text = ''
-        else:
-            unit_text = f' Unit: {unit}.'
-        when = {'immediately': 'Changes apply immediately.',
-                'next passage': 'Changes apply from the next passage (loop restart or '
-                                '~/reset).',
-                'restart': 'Read-only: set it when starting the node.'}[self.applies]
-        return f'{self.spec.description}{unit_text} Allowed: {self.allowed()}. {when}'
-
-
-_NODE_ONLY: dict[str, tuple[str, Any, Spec, bool]] = {
-    'scenario': ('string', DEFAULT_SCENARIO, Spec(
-        '-', 'Scenario to simulate: a YAML path or a built-in name (ttb-sim scenarios).'),
-        True),
-    'publish_rate_hz': ('double', 50.0, Spec(
-        'Hz', 'Rate of live messages in simulation time; 0 publishes every frame (the bag '
-        'always gets every frame).', low=0.0, high=10000.0), False),
-    'real_time_factor': ('double', 1.0, Spec(
-        '-', 'Simulated seconds per wall-clock second; 0 = as fast as possible.',
-        low=0.0, high=1000.0), False),
-    'loop': ('bool', False, Spec(
-        '-', 'Start a new passage when the train has left (otherwise the node idles).'),
-        False),
-    'publish_clock': ('bool', True, Spec(
-        '-', 'Publish simulation time on /clock.'), False),
-    'bag.enabled': ('bool', False, Spec(
-        '-', 'Record every topic at the full output rate to a rosbag2.'), True),
-    'bag.path': ('string', '', Spec(
-        '-', "Bag directory to create (must not exist); '' = runs/<scenario>-<time>."), True),
-    'bag.storage': ('string', 'mcap', Spec(
-        '-', 'rosbag2 storage plugin.', choices=tuple(STORAGES)), True),
-}
-
-_KIND_OF = {float: 'double', int: 'integer', str: 'string', bool: 'bool'}
-
-
-def _scenario_value(scenario: Scenario, key: str) -> Any:
-    value: Any = scenario
-    for part in key.split('.'):
-        value = getattr(value, part)
-    return value
-
-
-def parameter_table(scenario: Scenario | None = None) -> dict[str, NodeParameter]:
-    """
-    Return the node's parameters, in declaration order.
-
-    Parameters
-    ----------
-    scenario : Scenario, optional
-        The loaded scenario; the scenario-key parameters default to its values
-        (the schema defaults when omitted).
-
-    Returns
-    -------
-    dict
-        Parameter name -> :class:`NodeParameter`.
-
-    """
-    table: dict[str, NodeParameter] = {}
-    kind, default, spec, read_only = _NODE_ONLY['scenario']
-    table['scenario'] = NodeParameter('scenario', kind, default, spec, read_only, 'restart')
-    for key in SCENARIO_KEYS:
-        typ, schema_default, spec = key_spec(key)
-        value = schema_default if scenario is None else _scenario_value(scenario, key)
-        applies = 'next passage' if key in IRREGULARITY_KEYS else 'immediately'
-        table[key] = NodeParameter(key, _KIND_OF[typ], value, spec, not spec.dynamic,
-                                   applies if spec.dynamic else 'restart', key)
-    for name, (kind, default, spec, read_only) in _NODE_ONLY.items():
-        if name != 'scenario':
-            table[name] = NodeParameter(name, kind, default, spec, read_only,
-                                        'restart' if read_only else 'immediately')
-    return table
-
-
-def validate_parameter(param: NodeParameter, value: Any, *,
-                       initial: bool = False) -> tuple[bool, str]:
-    """
-    Check one proposed parameter value.
-
-    Parameters
-    ----------
-    param : NodeParameter
-        The parameter's declaration.
-    value : Any
-        Proposed value (as rclpy delivers it: bool, int, float, str or None).
-    initial : bool
-        True when checking the value given at start-up, where read-only
-        parameters may be set.
-
-    Returns
-    -------
-    tuple of (bool, str)
-        ``(True, '')`` when acceptable, else ``(False, reason)``; the reason
-        names the parameter, the value and the allowed values.
-
-    """
-    name, allowed = param.name, param.allowed()
-    if param.read_only and not initial:
-        return False, (f'{name} is read-only (allowed {allowed}); set it when starting the '
-                       f'node, e.g. --ros-args -p {name}:=...')
-    if param.kind == 'bool':
-        if not isinstance(value, bool):
-            return False, f'{name} = {value!r}: expected a bool, allowed {allowed}'
-        return True, ''
-    if param.kind == 'string':
-        if not isinstance(value, str):
-            return False, f'{name} = {value!r}: expected a string, allowed {allowed}'
-        if param.spec.choices is not None and value not in param.spec.choices:
-            return False, f'{name} = {value!r} is not allowed: allowed {allowed}'
-        if name == 'irregularity.file' and value and not Path(value).is_file():
-            return False, (f'{name} = {value!r}: no such file (allowed: a readable CSV '
-                           "path, or '' to synthesise from the spectrum)")
-        return True, ''
-    if isinstance(value, bool) or not isinstance(value, (int, float)):
-        kind = 'an integer' if param.kind == 'integer' else 'a number'
-        return False, f'{name} = {value!r}: expected {kind}, allowed {allowed}'
-    if param.kind == 'integer' and isinstance(value, float) and not value.is_integer():
-        return False, f'{name} = {value!r}: expected an integer, allowed {allowed}'
-    if not math.isfinite(value):
-        return False, f'{name} = {value!r}: expected a finite number, allowed {allowed}'
-    if not param.spec.contains(value):
-        return False, f'{name} = {value!r} is out of range: allowed {allowed}'
-    return True, ''
-
-
-def validate_changes(table: Mapping[str, NodeParameter],
-                     changes: Mapping[str, Any]) -> tuple[bool, str]:
-    """
-    Check a set of changes at once (all or nothing, as rclpy sets them).
-
-    Parameters
-    ----------
-    table : mapping
-        The parameter table.
-    changes : mapping
-        Parameter name -> proposed value.
-
-    Returns
-    -------
-    tuple of (bool, str)
-        The first refusal, or ``(True, '')``.
-
-    """
-    for name, value in changes.items():
-        param = table.get(name)
-        if param is None:
-            return False, f'unknown parameter {name!r}; known: {", ".join(table)}'
-        ok, reason = validate_parameter(param, value)
-        if not ok:
-            return ok, reason
-    return True, ''
-
-
-def normalize_value(param: NodeParameter, value: Any) -> Any:
-    """Return a validated value in the parameter's own type (an int 350 -> 350.0)."""
-    if param.kind == 'double':
-        return float(value)
-    if param.kind == 'integer':
-        return int(value)
-    return value
-
-
-def initial_values(table: Mapping[str, NodeParameter],
-                   given: Mapping[str, Any]) -> dict[str, Any]:
-    """
-    Merge start-up values with the defaults, validating each.
-
-    Parameters
-    ----------
-    table : mapping
-        The parameter table.
-    given : mapping
-        Values set at start-up (parameter overrides); missing names take defaults.
-
-    Returns
-    -------
-    dict
-        Every parameter's value, normalised to its type.
-
-    Raises
-    ------
-    ScenarioError
-        On the first invalid value (the message names the parameter and range).
-
-    """
-    values: dict[str, Any] = {}
-    for name, param in table.items():
-        value = given.get(name, param.default)
-        ok, reason = validate_parameter(param, value, initial=True)
-        if not ok:
-            raise ScenarioError(reason)
-        values[name] = normalize_value(param, value)
-    return values
-
-
-def scenario_with(scenario: Scenario, values: Mapping[str, Any]) -> Scenario:
-    """
-    Return a copy of a scenario with dotted keys replaced (validated again).
-
-    Raises
-    ------
-    ScenarioError
-        If a key is unknown or the combination is invalid.
-
-    """
-    data = scenario.to_dict()
-    apply_overrides(data, list(values.items()))
-    return from_mapping(data)
-
-
-# --------------------------------------------------------------------------------------
-# Passage controller
-# --------------------------------------------------------------------------------------
 
 class FrameSink(Protocol):
     """What the controller hands every frame to (a :class:`~ttb_sim.io.bag.BagRecorder`)."""
@@ -777,123 +485,3 @@ def frame_values(frame: Frame) -> list[tuple[str, str]]:
     for k, mid in enumerate(frame.midspan):
         out.append((f'span{k + 1:02d} midspan z (m)', f'{float(mid[2]):.6g}'))
     return out
-
-
-# --------------------------------------------------------------------------------------
-# Markers
-# --------------------------------------------------------------------------------------
-
-@dataclass(frozen=True)
-class Box:
-    """
-    An axis-aligned box marker in the track frame.
-
-    Attributes
-    ----------
-    ns : str
-        Marker namespace ('girders', 'piers', 'abutments', 'train', 'axles').
-    marker_id : int
-        Id, unique within the namespace.
-    position : tuple of float
-        Centre (x, y, z) in metres.
-    size : tuple of float
-        Edge lengths (x, y, z) in metres.
-    color : tuple of float
-        (r, g, b, a), each in [0, 1].
-
-    """
-
-    ns: str
-    marker_id: int
-    position: tuple[float, float, float]
-    size: tuple[float, float, float]
-    color: tuple[float, float, float, float]
-
-
-@dataclass(frozen=True)
-class MarkerSet:
-    """All markers of one ``~/model/markers`` message, in the frame ``frame_id``."""
-
-    boxes: tuple[Box, ...]
-    frame_id: str = FRAME_ID
-
-
-GIRDER_COLOR = (0.62, 0.62, 0.66, 1.0)
-PIER_COLOR = (0.45, 0.45, 0.50, 1.0)
-ABUTMENT_COLOR = (0.35, 0.35, 0.38, 1.0)
-CAR_COLOR = (0.85, 0.85, 0.95, 0.9)
-AXLE_COLOR = (0.9, 0.2, 0.15, 1.0)
-
-
-def _girder_depth(scenario: Scenario) -> float:
-    """Return a drawing depth of the girder (m): span/12, at least 0.5 m (display only)."""
-    return max(scenario.bridge.span_length / 12.0, 0.5)
-
-
-def model_markers(scenario: Scenario) -> list[Box]:
-    """
-    Describe the static structure: one box per girder, pier and abutment.
-
-    The deck top is at z = 0; widths and depths are display values (the beam
-    model has no cross-section geometry beyond its stiffness and mass).
-
-    Parameters
-    ----------
-    scenario : Scenario
-        The scenario.
-
-    Returns
-    -------
-    list of Box
-
-    """
-    b = scenario.bridge
-    depth = _girder_depth(scenario)
-    width = scenario.bearings.spacing + 2.0
-    gap = min(0.1, 0.01 * b.span_length)
-    boxes = [Box('girders', k, ((k + 0.5) * b.span_length, 0.0, -depth / 2),
-                 (b.span_length - gap, width, depth), GIRDER_COLOR)
-             for k in range(b.n_spans)]
-    height = scenario.piers.height
-    for s in range(b.n_spans + 1):
-        x = s * b.span_length
-        if s in (0, b.n_spans):
-            boxes.append(Box('abutments', s, (x, 0.0, -depth - 1.5), (2.0, width + 1.0, 3.0),
-                             ABUTMENT_COLOR))
-        else:
-            boxes.append(Box('piers', s, (x, 0.0, -depth - height / 2),
-                             (2.0, 0.6 * width, height), PIER_COLOR))
-    return boxes
-
-
-def train_markers(scenario: Scenario, head_position: float) -> list[Box]:
-    """
-    Describe the train at a head position: car bodies and one small box per axle.
-
-    Parameters
-    ----------
-    scenario : Scenario
-        The scenario (train layout).
-    head_position : float
-        Position of the train head along the track (m).
-
-    Returns
-    -------
-    list of Box
-
-    """
-    t = scenario.train
-    offsets = scenario.axle_positions()
-    boxes = [Box('axles', i, (head_position - a, 0.0, 0.5), (1.0, 1.5, 1.0), AXLE_COLOR)
-             for i, a in enumerate(offsets)]
-    if not t.axle_offsets:
-        for c in range(t.n_cars):
-            x = head_position - (c + 0.5) * t.car_length
-            boxes.append(Box('train', c, (x, 0.0, 2.4), (t.car_length - 0.6, 3.2, 3.6),
-                             CAR_COLOR))
-    return boxes
-
-
-def markers(scenario: Scenario, head_position: float) -> MarkerSet:
-    """Return the complete marker set: structure and train (sent latched as a whole)."""
-    return MarkerSet(tuple(model_markers(scenario) + train_markers(scenario, head_position)))

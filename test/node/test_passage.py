@@ -12,28 +12,20 @@
 # See the License for the specific language governing permissions and
 # limitations under the License.
 
-"""Tests of the simulator node's ROS-free logic: parameters, passages, pacing, markers."""
+"""Tests of the passage controller: passages, speed changes, pacing, recording, diagnostics."""
 
 from __future__ import annotations
 
-import math
 from pathlib import Path
 
 import pytest
 from rosbags.highlevel import AnyReader
-from ttb_sim.config import key_spec, load_scenario, Scenario
-from ttb_sim.errors import ScenarioError
+from ttb_sim.config import load_scenario, Scenario
 from ttb_sim.io.bag import BagRecorder
 from ttb_sim.io.topics import topic_table
-from ttb_sim.node_logic import (ERROR, initial_values, markers, model_markers, OK, parameter_table,
-                                PassageController, SCENARIO_KEYS, train_markers, validate_changes,
-                                validate_parameter)
+from ttb_sim.node.parameters import initial_values, parameter_table
+from ttb_sim.node.passage import ERROR, OK, PassageController
 from ttb_sim.sim.frames import Frame
-
-CONTRACT_PARAMETERS = {
-    'scenario', 'train.speed_kmh', 'irregularity.spectrum', 'irregularity.seed',
-    'irregularity.file', 'irregularity.scale', 'publish_rate_hz', 'real_time_factor', 'loop',
-    'publish_clock', 'bag.enabled', 'bag.path', 'bag.storage'}
 
 
 class FakeClock:
@@ -61,11 +53,6 @@ class ListRecorder:
         self.closed = True
 
 
-@pytest.fixture(scope='module')
-def beam() -> Scenario:
-    return load_scenario('moving_force_beam')
-
-
 def controller(scenario: Scenario, recorder=None, clock=None, **values) -> PassageController:
     table = parameter_table(scenario)
     given = {'real_time_factor': 0.0}
@@ -83,106 +70,6 @@ def run_until_idle(c: PassageController) -> list[Frame]:
             break
         published.extend(c.advance(budget=5.0).frames)
     return published
-
-
-# -- parameter table ------------------------------------------------------------------------
-
-def test_parameter_names_are_the_contract(beam):
-    assert set(parameter_table(beam)) == CONTRACT_PARAMETERS
-
-
-def test_scenario_parameters_come_from_the_schema(beam):
-    table = parameter_table(beam)
-    kinds = {float: 'double', int: 'integer', str: 'string'}
-    for key in SCENARIO_KEYS:
-        typ, _, spec = key_spec(key)
-        p = table[key]
-        assert p.spec is spec
-        assert p.kind == kinds[typ]
-        assert p.scenario_key == key
-        assert p.read_only is not spec.dynamic
-        assert spec.description in p.description()
-    # defaults follow the loaded scenario, not the schema
-    assert table['train.speed_kmh'].default == 200.0
-    assert parameter_table()['train.speed_kmh'].default == key_spec('train.speed_kmh')[1]
-
-
-def test_descriptions_carry_unit_range_and_when_changes_apply(beam):
-    table = parameter_table(beam)
-    speed = table['train.speed_kmh'].description()
-    assert 'Unit: km/h' in speed and '(0, 10000] km/h' in speed and 'immediately' in speed
-    assert 'next passage' in table['irregularity.seed'].description()
-    assert 'Unit: Hz' in table['publish_rate_hz'].description()
-    assert 'Read-only' in table['bag.storage'].description()
-    assert "'mcap', 'sqlite3'" in table['bag.storage'].description()
-
-
-def test_read_only_parameters_are_structural(beam):
-    ro = {n for n, p in parameter_table(beam).items() if p.read_only}
-    assert ro == {'scenario', 'bag.enabled', 'bag.path', 'bag.storage'}
-
-
-def test_spectrum_choices_are_read_from_the_schema(beam):
-    p = parameter_table(beam)['irregularity.spectrum']
-    assert p.spec.choices == key_spec('irregularity.spectrum')[2].choices
-    for choice in p.spec.choices:
-        assert validate_parameter(p, choice) == (True, '')
-
-
-# -- validation -----------------------------------------------------------------------------
-
-@pytest.mark.parametrize('value', [350, 350.0, 1, 10000])
-def test_integer_and_float_speed_accepted(beam, value):
-    assert validate_parameter(parameter_table(beam)['train.speed_kmh'], value) == (True, '')
-
-
-@pytest.mark.parametrize('name, value, fragments', [
-    ('train.speed_kmh', -5, ['train.speed_kmh', '-5', 'out of range', '(0, 10000] km/h']),
-    ('train.speed_kmh', 0.0, ['train.speed_kmh', '0.0', '(0, 10000] km/h']),
-    ('train.speed_kmh', 10000.5, ['train.speed_kmh', '10000.5', '(0, 10000] km/h']),
-    ('train.speed_kmh', 'fast', ['train.speed_kmh', "'fast'", 'a number', '(0, 10000]']),
-    ('train.speed_kmh', True, ['train.speed_kmh', 'True', 'a number']),
-    ('train.speed_kmh', None, ['train.speed_kmh', 'None', 'a number']),
-    ('train.speed_kmh', math.nan, ['train.speed_kmh', 'nan', 'finite']),
-    ('irregularity.seed', -1, ['irregularity.seed', '-1', '[0, 2147483647]']),
-    ('irregularity.seed', 1.5, ['irregularity.seed', '1.5', 'an integer']),
-    ('irregularity.scale', 101, ['irregularity.scale', '101', '[0, 100]']),
-    ('irregularity.spectrum', 'no_such', ['irregularity.spectrum', "'no_such'", "one of 'none'"]),
-    ('irregularity.file', '/no/such/profile.csv', ['irregularity.file', 'no such file']),
-    ('publish_rate_hz', -1.0, ['publish_rate_hz', '-1.0', '[0, 10000] Hz']),
-    ('real_time_factor', -0.5, ['real_time_factor', '-0.5', '[0, 1000]']),
-    ('loop', 'yes', ['loop', "'yes'", 'true or false']),
-    ('publish_clock', 1, ['publish_clock', 'a bool']),
-    ('scenario', 'sprung_mass_beam', ['scenario', 'read-only']),
-    ('bag.enabled', True, ['bag.enabled', 'read-only']),
-    ('bag.storage', 'sqlite3', ['bag.storage', 'read-only', "'mcap', 'sqlite3'"]),
-])
-def test_refusals_name_parameter_value_and_range(beam, name, value, fragments):
-    ok, reason = validate_parameter(parameter_table(beam)[name], value)
-    assert not ok
-    for fragment in fragments:
-        assert fragment in reason, reason
-
-
-def test_changes_are_checked_all_or_nothing(beam):
-    table = parameter_table(beam)
-    ok, reason = validate_changes(table, {'train.speed_kmh': 350, 'irregularity.scale': -1})
-    assert not ok and 'irregularity.scale' in reason
-    ok, reason = validate_changes(table, {'no.such': 1})
-    assert not ok and "unknown parameter 'no.such'" in reason
-    assert validate_changes(table, {'train.speed_kmh': 350, 'loop': True}) == (True, '')
-
-
-def test_start_up_values_validated_and_normalised(beam):
-    table = parameter_table(beam)
-    values = initial_values(table, {'train.speed_kmh': 350, 'bag.enabled': True})
-    assert values['train.speed_kmh'] == 350.0 and isinstance(values['train.speed_kmh'], float)
-    assert values['bag.enabled'] is True  # read-only values may be set at start-up
-    assert values['publish_rate_hz'] == 50.0
-    with pytest.raises(ScenarioError, match=r'train\.speed_kmh = -5 .*\(0, 10000\] km/h'):
-        initial_values(table, {'train.speed_kmh': -5})
-    with pytest.raises(ScenarioError, match=r"bag\.storage = 'zip'.*'mcap', 'sqlite3'"):
-        initial_values(table, {'bag.storage': 'zip'})
 
 
 # -- passage controller ---------------------------------------------------------------------
@@ -402,28 +289,6 @@ def test_diagnostics_warn_when_slower_than_requested(beam):
     clock.now += 0.8
     report = c.diagnostics()
     assert report.level == 1 and 'slower than requested' in report.message
-
-
-# -- markers --------------------------------------------------------------------------------
-
-def test_markers_describe_girders_supports_and_train():
-    scenario = load_scenario('moving_force_beam', ['bridge.n_spans=3', 'train.axle_offsets=[]',
-                                                   'train.n_cars=2'])
-    boxes = model_markers(scenario)
-    ns = [b.ns for b in boxes]
-    assert ns.count('girders') == 3 and ns.count('piers') == 2 and ns.count('abutments') == 2
-    girder = next(b for b in boxes if b.ns == 'girders' and b.marker_id == 1)
-    assert girder.position[0] == pytest.approx(1.5 * 32.0)
-    train = train_markers(scenario, 100.0)
-    cars = [b for b in train if b.ns == 'train']
-    axles = [b for b in train if b.ns == 'axles']
-    assert len(cars) == 2 and len(axles) == 8
-    assert cars[0].position[0] == pytest.approx(100.0 - 12.5)
-    assert all(0 <= v <= 1 for b in boxes + train for v in b.color)
-    full = markers(scenario, 100.0)
-    assert full.frame_id == 'track' and len(full.boxes) == len(boxes) + len(train)
-    ids = [(b.ns, b.marker_id) for b in full.boxes]
-    assert len(ids) == len(set(ids))
 
 
 def test_markers_refresh_is_throttled(beam):

@@ -1,0 +1,39 @@
+# Copyright 2026 The ttb_sim Authors
+#
+# Licensed under the Apache License, Version 2.0 (the "License");
+# you may not use this file except in compliance with the License.
+# You may obtain a copy of the License at
+#
+#     http://www.apache.org/licenses/LICENSE-2.0
+#
+# Unless required by applicable law or agreed to in writing, software
+# distributed under the License is distributed on an "AS IS" BASIS,
+# WITHOUT WARRANTIES OR CONDITIONS OF ANY KIND, either express or implied.
+# See the License for the specific language governing permissions and
+# limitations under the License.
+
+"""Tests of the structure and train markers (plain boxes for ~/model/markers)."""
+
+import pytest
+from ttb_sim.config import load_scenario
+from ttb_sim.node.markers import markers, model_markers, train_markers
+
+
+def test_markers_describe_girders_supports_and_train():
+    scenario = load_scenario('moving_force_beam', ['bridge.n_spans=3', 'train.axle_offsets=[]',
+                                                   'train.n_cars=2'])
+    boxes = model_markers(scenario)
+    ns = [b.ns for b in boxes]
+    assert ns.count('girders') == 3 and ns.count('piers') == 2 and ns.count('abutments') == 2
+    girder = next(b for b in boxes if b.ns == 'girders' and b.marker_id == 1)
+    assert girder.position[0] == pytest.approx(1.5 * 32.0)
+    train = train_markers(scenario, 100.0)
+    cars = [b for b in train if b.ns == 'train']
+    axles = [b for b in train if b.ns == 'axles']
+    assert len(cars) == 2 and len(axles) == 8
+    assert cars[0].position[0] == pytest.approx(100.0 - 12.5)
+    assert all(0 <= v <= 1 for b in boxes + train for v in b.color)
+    full = markers(scenario, 100.0)
+    assert full.frame_id == 'track' and len(full.boxes) == len(boxes) + len(train)
+    ids = [(b.ns, b.marker_id) for b in full.boxes]
+    assert len(ids) == len(set(ids))

@@ -1,0 +1,61 @@
+# Copyright 2026 The ttb_sim Authors
+#
+# Licensed under the Apache License, Version 2.0 (the "License");
+# you may not use this file except in compliance with the License.
+# You may obtain a copy of the License at
+#
+#     http://www.apache.org/licenses/LICENSE-2.0
+#
+# Unless required by applicable law or agreed to in writing, software
+# distributed under the License is distributed on an "AS IS" BASIS,
+# WITHOUT WARRANTIES OR CONDITIONS OF ANY KIND, either express or implied.
+# See the License for the specific language governing permissions and
+# limitations under the License.
+
+"""
+The simulator node's logic, free of ROS, so that it is tested where ROS 2 is absent.
+
+:mod:`ttb_sim.simulator_node` is a thin rclpy shell over this package: it only
+copies values into and out of rclpy objects.
+
+- :mod:`~ttb_sim.node.parameters`: the parameter table (derived from the scenario
+  schema), validation and normalisation of values, start-up values, the
+  scenario of a passage;
+- :mod:`~ttb_sim.node.passage`: the :class:`PassageController` that steps,
+  paces, records and reports passages (ticks, frame sink, diagnostics);
+- :mod:`~ttb_sim.node.markers`: the structure and train markers as plain boxes.
+"""
+
+from ttb_sim.node.markers import Box, markers, MarkerSet, model_markers, train_markers
+from ttb_sim.node.parameters import (DEFAULT_SCENARIO, initial_values, IRREGULARITY_KEYS,
+                                     NodeParameter, normalize_value, parameter_table,
+                                     SCENARIO_KEYS, scenario_with, validate_changes,
+                                     validate_parameter)
+from ttb_sim.node.passage import (DiagnosticsReport, ERROR, frame_values, FrameSink, OK,
+                                  PassageController, Tick, WARN)
+
+__all__ = [
+    'Box',
+    'DEFAULT_SCENARIO',
+    'DiagnosticsReport',
+    'ERROR',
+    'frame_values',
+    'FrameSink',
+    'initial_values',
+    'IRREGULARITY_KEYS',
+    'MarkerSet',
+    'markers',
+    'model_markers',
+    'NodeParameter',
+    'normalize_value',
+    'OK',
+    'parameter_table',
+    'PassageController',
+    'SCENARIO_KEYS',
+    'scenario_with',
+    'Tick',
+    'train_markers',
+    'validate_changes',
+    'validate_parameter',
+    'WARN',
+]

@@ -1,0 +1,145 @@
+# Copyright 2026 The ttb_sim Authors
+#
+# Licensed under the Apache License, Version 2.0 (the "License");
+# you may not use this file except in compliance with the License.
+# You may obtain a copy of the License at
+#
+#     http://www.apache.org/licenses/LICENSE-2.0
+#
+# Unless required by applicable law or agreed to in writing, software
+# distributed under the License is distributed on an "AS IS" BASIS,
+# WITHOUT WARRANTIES OR CONDITIONS OF ANY KIND, either express or implied.
+# See the License for the specific language governing permissions and
+# limitations under the License.
+
+
+"""
+The RViz / Foxglove markers of ``~/model/markers``, described as plain data.
+
+:func:`model_markers` gives one :class:`Box` per girder, pier and abutment,
+:func:`train_markers` the car bodies and axles at a head position, and
+:func:`markers` the complete :class:`MarkerSet` that the node sends latched.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from ttb_sim.config import Scenario
+from ttb_sim.io.topics import FRAME_ID
+
+
+@dataclass(frozen=True)
+class Box:
+    """
+    An axis-aligned box marker in the track frame.
+
+    Attributes
+    ----------
+    ns : str
+        Marker namespace ('girders', 'piers', 'abutments', 'train', 'axles').
+    marker_id : int
+        Id, unique within the namespace.
+    position : tuple of float
+        Centre (x, y, z) in metres.
+    size : tuple of float
+        Edge lengths (x, y, z) in metres.
+    color : tuple of float
+        (r, g, b, a), each in [0, 1].
+
+    """
+
+    ns: str
+    marker_id: int
+    position: tuple[float, float, float]
+    size: tuple[float, float, float]
+    color: tuple[float, float, float, float]
+
+
+@dataclass(frozen=True)
+class MarkerSet:
+    """All markers of one ``~/model/markers`` message, in the frame ``frame_id``."""
+
+    boxes: tuple[Box, ...]
+    frame_id: str = FRAME_ID
+
+
+GIRDER_COLOR = (0.62, 0.62, 0.66, 1.0)
+PIER_COLOR = (0.45, 0.45, 0.50, 1.0)
+ABUTMENT_COLOR = (0.35, 0.35, 0.38, 1.0)
+CAR_COLOR = (0.85, 0.85, 0.95, 0.9)
+AXLE_COLOR = (0.9, 0.2, 0.15, 1.0)
+
+
+def _girder_depth(scenario: Scenario) -> float:
+    """Return a drawing depth of the girder (m): span/12, at least 0.5 m (display only)."""
+    return max(scenario.bridge.span_length / 12.0, 0.5)
+
+
+def model_markers(scenario: Scenario) -> list[Box]:
+    """
+    Describe the static structure: one box per girder, pier and abutment.
+
+    The deck top is at z = 0; widths and depths are display values (the beam
+    model has no cross-section geometry beyond its stiffness and mass).
+
+    Parameters
+    ----------
+    scenario : Scenario
+        The scenario.
+
+    Returns
+    -------
+    list of Box
+
+    """
+    b = scenario.bridge
+    depth = _girder_depth(scenario)
+    width = scenario.bearings.spacing + 2.0
+    gap = min(0.1, 0.01 * b.span_length)
+    boxes = [Box('girders', k, ((k + 0.5) * b.span_length, 0.0, -depth / 2),
+                 (b.span_length - gap, width, depth), GIRDER_COLOR)
+             for k in range(b.n_spans)]
+    height = scenario.piers.height
+    for s in range(b.n_spans + 1):
+        x = s * b.span_length
+        if s in (0, b.n_spans):
+            boxes.append(Box('abutments', s, (x, 0.0, -depth - 1.5), (2.0, width + 1.0, 3.0),
+                             ABUTMENT_COLOR))
+        else:
+            boxes.append(Box('piers', s, (x, 0.0, -depth - height / 2),
+                             (2.0, 0.6 * width, height), PIER_COLOR))
+    return boxes
+
+
+def train_markers(scenario: Scenario, head_position: float) -> list[Box]:
+    """
+    Describe the train at a head position: car bodies and one small box per axle.
+
+    Parameters
+    ----------
+    scenario : Scenario
+        The scenario (train layout).
+    head_position : float
+        Position of the train head along the track (m).
+
+    Returns
+    -------
+    list of Box
+
+    """
+    t = scenario.train
+    offsets = scenario.axle_positions()
+    boxes = [Box('axles', i, (head_position - a, 0.0, 0.5), (1.0, 1.5, 1.0), AXLE_COLOR)
+             for i, a in enumerate(offsets)]
+    if not t.axle_offsets:
+        for c in range(t.n_cars):
+            x = head_position - (c + 0.5) * t.car_length
+            boxes.append(Box('train', c, (x, 0.0, 2.4), (t.car_length - 0.6, 3.2, 3.6),
+                             CAR_COLOR))
+    return boxes
+
+
+def markers(scenario: Scenario, head_position: float) -> MarkerSet:
+    """Return the complete marker set: structure and train (sent latched as a whole)."""
+    return MarkerSet(tuple(model_markers(scenario) + train_markers(scenario, head_position)))
