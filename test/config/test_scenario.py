@@ -100,3 +100,13 @@ def test_axle_layout_from_car_geometry():
     assert axles[1] - axles[0] == pytest.approx(2.5)
     assert axles[2] - axles[0] == pytest.approx(15.7)
     assert axles[4] - axles[0] == pytest.approx(25.0)
+
+
+def test_moved_car_geometry_keys_point_to_their_new_home():
+    """train.bogie_semi_spacing moved to the car record: refused, naming the new key."""
+    with pytest.raises(ScenarioError, match="moved to 'car.bogie_semi_spacing'"):
+        load_scenario('moving_force_beam', ['train.bogie_semi_spacing=7.0'])
+    s = load_scenario('moving_force_beam', ['car.wheelbase_semi=1.5', 'train.axle_offsets=[]',
+                                            'train.n_cars=1'])
+    axles = s.axle_positions()
+    assert axles[1] - axles[0] == pytest.approx(3.0)

@@ -31,7 +31,19 @@ from typing import Any, Iterator, Mapping
 from ttb_sim.errors import ModelError, ScenarioError
 from ttb_sim.parameters import Spec
 
-__all__ = ['from_mapping', 'iter_keys', 'key_spec', 'to_plain']
+__all__ = ['from_mapping', 'iter_keys', 'key_spec', 'MOVED_KEYS', 'to_plain']
+
+MOVED_KEYS = {
+    'train.bogie_semi_spacing': 'car.bogie_semi_spacing',
+    'train.wheelbase_semi': 'car.wheelbase_semi',
+}
+"""Keys that moved to another section (old path -> new path), refused with a pointer."""
+
+
+def _moved(path: str) -> str:
+    """Return a hint for a key that moved, or an empty string."""
+    new = MOVED_KEYS.get(path)
+    return f' (it moved to {new!r}: the car record holds the car geometry)' if new else ''
 
 
 # --------------------------------------------------------------------------------------
@@ -71,7 +83,8 @@ def key_spec(path: str) -> tuple[type, Any, Spec]:
     for key, typ, default, spec in iter_keys():
         if key == path:
             return typ, default, spec
-    raise ScenarioError(f'unknown key {path!r}; see `ttb-sim scenarios --keys` for the list')
+    raise ScenarioError(f'unknown key {path!r}{_moved(path)}; see `ttb-sim scenarios --keys` '
+                        'for the list')
 
 
 def _root(cls: type | None) -> type:
@@ -117,7 +130,7 @@ def from_mapping(data: Mapping[str, Any], cls: type | None = None, prefix: str =
         path = f'{prefix}{key}'
         if key not in names:
             allowed = ', '.join(sorted(names))
-            raise ScenarioError(f'unknown key {path!r}; allowed here: {allowed}')
+            raise ScenarioError(f'unknown key {path!r}{_moved(path)}; allowed here: {allowed}')
         f = names[key]
         if 'spec' in f.metadata:
             kwargs[key] = _coerce(path, value, hints[key], f.metadata['spec'])

@@ -159,7 +159,7 @@ def base_scenario(values: Sequence[tuple[str, Any]] = (),
 
 def wheel_offsets(scenario: Scenario) -> np.ndarray:
     """Return the distances of the car's axles behind the head (m), from the car geometry."""
-    return np.asarray(scenario.train.axle_positions(), dtype=float)
+    return np.asarray(scenario.axle_positions(), dtype=float)
 
 
 def track_start(scenario: Scenario) -> float:
