@@ -33,7 +33,7 @@ import scipy.linalg
 
 from ttb_sim.model.vehicle import stability as st
 from ttb_sim.model.vehicle.car import CarParameters, contact_map, N_DOF, wheelset_dofs
-from ttb_sim.model.wheel_rail import contact as ct
+import ttb_sim.model.wheel_rail as ct
 from ttb_sim.model.wheel_rail.profiles import contact_geometry_table
 
 KMH = 1.0 / 3.6

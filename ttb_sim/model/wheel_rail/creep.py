@@ -13,56 +13,50 @@
 # limitations under the License.
 
 """
-Compute wheel-rail contact forces: Hertz normal contact, Kalker creep, saturation.
+Tangential wheel-rail contact: Kalker's linear creep theory and its saturation.
 
-Contents (PHYSICS.md section 2):
+Contents (PHYSICS.md section 2.2):
 
-* Zhai's Hertz law P = (delta / G)^(3/2) for delta > 0, else 0 (loss of
-  contact), with G for conical and worn (LM) treads; its tangent stiffness,
-  the static compression at a load and the linearised stiffness.
-* Hertz elliptic contact (semi-axes, peak pressure, approach) from the
-  principal curvatures, with complete elliptic integrals from scipy.
-* Kalker's linear creep coefficients f11, f22, f23, f33 from the ellipse and
-  Kalker's tabulated C_ij(a/b, nu), and their exact Hertz scaling with load.
-* Creepages from the simplified (equivalent-cone) contact geometry of
-  PHYSICS.md section 2.3, or from profile rolling radii and contact angles.
-* Shen-Hedrick-Elkins saturation of the linear creep forces.
+* Kalker's linear creep coefficients f11, f22, f23, f33 from the contact
+  ellipse and Kalker's tabulated C_ij(a/b, nu), and their exact Hertz scaling
+  with load (:data:`CREEP_LOAD_EXPONENTS`).
+* Kalker's linear creep forces from the creepages of :mod:`.geometry`.
+* Shen-Hedrick-Elkins saturation of the linear creep forces, with the
+  derivatives of its reduction factor for Jacobians.
 
-Sign conventions (REP 103 track frame: x forward, y left, z up)
----------------------------------------------------------------
-Side s = +1 is the left wheel, s = -1 the right wheel.  A compression
-delta > 0 means the wheel and rail overlap.  Creepages are the slip velocity
-of the wheel relative to the rail at the contact point divided by V (spin:
-relative angular velocity about the contact normal divided by V), and the
-linear forces on the wheel are Fx = -f11 xi_x, Fy = -f22 xi_y - f23 xi_sp,
-Mz = f23 xi_y - f33 xi_sp (PHYSICS.md section 2.2).  The contact angle
-gamma_s > 0 tilts the normal force on wheel s towards the track centre (the
-usual coned-tread case, for both wheels).  PHYSICS.md writes the creepages
-in Zhai's axes; with y to the left here, the longitudinal creepage of the
-left wheel of a wheelset displaced to the left is negative, so the creep
-forces steer the wheelset back to the track centre.
+Sign conventions (REP 103 track frame: x forward, y left, z up): the linear
+forces on the wheel are Fx = -f11 xi_x, Fy = -f22 xi_y - f23 xi_sp,
+Mz = f23 xi_y - f33 xi_sp (PHYSICS.md section 2.2), with the creepages
+defined in :mod:`.geometry`.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
 import math
 
 import numpy as np
 from numpy.typing import ArrayLike
-from scipy.special import ellipe, ellipk
 
-from ttb_sim.errors import ScenarioError
+from ttb_sim.errors import ModelError
+from ttb_sim.model.wheel_rail._checks import check_positive
+from ttb_sim.model.wheel_rail.hertz import POISSON_RATIO, YOUNG_MODULUS
 
-#: Young's modulus of wheel and rail steel (Pa).
-YOUNG_MODULUS = 2.06e11
-#: Poisson's ratio of wheel and rail steel (-).
-POISSON_RATIO = 0.3
+__all__ = [
+    'CREEP_LOAD_EXPONENTS',
+    'FRICTION_COEFFICIENT',
+    'KALKER_RATIO_RANGE',
+    'creep_coefficients',
+    'kalker_coefficients',
+    'linear_creep_forces',
+    'scale_creep_coefficients',
+    'she_factor_derivative',
+    'she_factor_gradient',
+    'she_ratio',
+    'she_saturation',
+]
+
 #: Default friction coefficient for saturation (-).
 FRICTION_COEFFICIENT = 0.3
-
-#: Tread types with a Zhai contact constant.
-TREADS = ('lm', 'conical')
 
 # Kalker (1990), "Three-dimensional elastic bodies in rolling contact", Kluwer,
 # Table E.3: C11, C22, C23 of the linear theory for elliptic contact, at
@@ -119,252 +113,6 @@ _KALKER_TABLE = {
 KALKER_RATIO_RANGE = (0.1, 10.0)
 
 
-def _check_positive(name: str, value: ArrayLike) -> np.ndarray:
-    arr = np.asarray(value, dtype=float)
-    if not np.all(np.isfinite(arr) & (arr > 0.0)):
-        bad = arr[~(np.isfinite(arr) & (arr > 0.0))].ravel()[0]
-        raise ScenarioError(f'{name} = {bad!r} is invalid; allowed: finite and > 0')
-    return arr
-
-
-def hertz_constant(radius: ArrayLike = 0.46, tread: str = 'lm') -> np.ndarray:
-    """
-    Return Zhai's wheel-rail contact constant G (m/N^(2/3)).
-
-    G = 4.57e-8 R^-0.149 for a conical tread and G = 3.86e-8 R^-0.115 for a
-    worn (LM-type) tread, R being the wheel radius in m (PHYSICS.md 2.1).
-
-    Parameters
-    ----------
-    radius : array_like
-        Wheel rolling radius R (m), > 0.
-    tread : {'lm', 'conical'}
-        Tread type.
-
-    Returns
-    -------
-    numpy.ndarray
-        G (m/N^(2/3)), same shape as ``radius`` (4.22e-8 for LM at 0.46 m).
-
-    Raises
-    ------
-    ScenarioError
-        On a non-positive radius or an unknown tread.
-
-    """
-    r = _check_positive('wheel radius', radius)
-    if tread == 'lm':
-        return 3.86e-8 * r ** -0.115
-    if tread == 'conical':
-        return 4.57e-8 * r ** -0.149
-    raise ScenarioError(f'tread = {tread!r} is unknown; allowed: {", ".join(TREADS)}')
-
-
-def normal_force(compression: ArrayLike, g_constant: ArrayLike) -> np.ndarray:
-    """
-    Return the Hertz normal force P = (delta / G)^(3/2), zero where delta <= 0.
-
-    Parameters
-    ----------
-    compression : array_like
-        Elastic compression delta (m), positive when wheel and rail overlap.
-    g_constant : array_like
-        Contact constant G (m/N^(2/3)), broadcast against ``compression``.
-
-    Returns
-    -------
-    numpy.ndarray
-        Normal force (N) pushing wheel and rail apart; 0 on loss of contact.
-
-    """
-    d = np.maximum(np.asarray(compression, dtype=float), 0.0)
-    return (d / np.asarray(g_constant, dtype=float)) ** 1.5
-
-
-def normal_force_derivative(compression: ArrayLike, g_constant: ArrayLike) -> np.ndarray:
-    """
-    Return the tangent stiffness dP/d(delta) = 1.5 delta^(1/2) / G^(3/2).
-
-    Parameters
-    ----------
-    compression : array_like
-        Elastic compression delta (m).
-    g_constant : array_like
-        Contact constant G (m/N^(2/3)).
-
-    Returns
-    -------
-    numpy.ndarray
-        Tangent stiffness (N/m); 0 where delta <= 0.
-
-    """
-    d = np.maximum(np.asarray(compression, dtype=float), 0.0)
-    return 1.5 * np.sqrt(d) / np.asarray(g_constant, dtype=float) ** 1.5
-
-
-def static_compression(load: ArrayLike, g_constant: ArrayLike) -> np.ndarray:
-    """
-    Return the compression delta0 = G P0^(2/3) under a static load.
-
-    Parameters
-    ----------
-    load : array_like
-        Static wheel load P0 (N), >= 0.
-    g_constant : array_like
-        Contact constant G (m/N^(2/3)).
-
-    Returns
-    -------
-    numpy.ndarray
-        delta0 (m); 77 um for P0 = 78.48 kN and the LM tread at R = 0.46 m.
-
-    """
-    p = np.asarray(load, dtype=float)
-    if np.any(~np.isfinite(p) | (p < 0.0)):
-        raise ScenarioError(f'static load = {load!r} N is invalid; allowed: finite and >= 0')
-    return np.asarray(g_constant, dtype=float) * p ** (2.0 / 3.0)
-
-
-def linearised_stiffness(load: ArrayLike, g_constant: ArrayLike) -> np.ndarray:
-    """
-    Return the linearised Hertz stiffness k_H = 1.5 P0^(1/3) / G at a load.
-
-    Parameters
-    ----------
-    load : array_like
-        Static wheel load P0 (N), > 0.
-    g_constant : array_like
-        Contact constant G (m/N^(2/3)).
-
-    Returns
-    -------
-    numpy.ndarray
-        k_H (N/m); 1.52e9 N/m for P0 = 78.48 kN and the LM tread at 0.46 m.
-
-    """
-    p = _check_positive('static load', load)
-    return 1.5 * p ** (1.0 / 3.0) / np.asarray(g_constant, dtype=float)
-
-
-@dataclass(frozen=True)
-class HertzEllipse:
-    """
-    Hertz solution of an elliptic contact.
-
-    Attributes
-    ----------
-    a : numpy.ndarray
-        Semi-axis along the rolling direction x (m).
-    b : numpy.ndarray
-        Semi-axis along the lateral direction y (m).
-    peak_pressure : numpy.ndarray
-        p0 = 3 P / (2 pi a b) (Pa).
-    approach : numpy.ndarray
-        Elastic approach delta of the two bodies (m).
-    g_equivalent : numpy.ndarray
-        delta / P^(2/3) (m/N^(2/3)), comparable with Zhai's G.
-
-    """
-
-    a: np.ndarray
-    b: np.ndarray
-    peak_pressure: np.ndarray
-    approach: np.ndarray
-    g_equivalent: np.ndarray
-
-
-def _curvature_ratio(g: np.ndarray) -> np.ndarray:
-    """Return B/A (>= 1) of the Hertz ellipse whose minor/major axis ratio is g."""
-    m = np.clip(1.0 - g * g, 1e-14, 1.0)
-    k, e = ellipk(m), ellipe(m)
-    return (e / (g * g) - k) / (k - e)
-
-
-def hertz_ellipse(load: ArrayLike, rolling_radius: ArrayLike = 0.46,
-                  rail_transverse_radius: ArrayLike = 0.30, *,
-                  wheel_transverse_radius: ArrayLike = math.inf,
-                  rail_longitudinal_radius: ArrayLike = math.inf,
-                  young_modulus: float = YOUNG_MODULUS,
-                  poisson_ratio: float = POISSON_RATIO) -> HertzEllipse:
-    """
-    Solve Hertz's elliptic contact between wheel and rail (vectorised).
-
-    The gap is h = A x^2 + B y^2 with A = (1/R_wx + 1/R_rx)/2 and
-    B = (1/R_wy + 1/R_ry)/2; radii are positive for convex surfaces and negative
-    for concave ones (a worn, hollow wheel tread has a negative transverse
-    radius), infinite for flat directions.  With e^2 = 1 - g^2 (g = minor/major
-    axis ratio), the ratio of the curvatures fixes g through
-    B/A = (E(e)/g^2 - K(e)) / (K(e) - E(e)) (larger over smaller curvature), the
-    major semi-axis follows from c^3 = 3 P (K - E) / (2 pi E* e^2 A_min), and
-    delta = p0 b_minor K(e) / E*, with E* = E / (2 (1 - nu^2)) for equal
-    materials (Johnson, Contact Mechanics, section 3.4).
-
-    Parameters
-    ----------
-    load : array_like
-        Normal load P (N), > 0.
-    rolling_radius : array_like
-        Wheel rolling radius R_wx (m), > 0.
-    rail_transverse_radius : array_like
-        Rail head (crown) radius R_ry (m).
-    wheel_transverse_radius : array_like
-        Wheel profile radius R_wy (m); infinite for a conical tread.
-    rail_longitudinal_radius : array_like
-        Rail radius along the track R_rx (m); infinite for straight rail.
-    young_modulus : float
-        E (Pa) of both bodies.
-    poisson_ratio : float
-        nu (-) of both bodies.
-
-    Returns
-    -------
-    HertzEllipse
-        a, b, p0, approach and G-equivalent, broadcast over the inputs.
-
-    Raises
-    ------
-    ScenarioError
-        If a load is not positive or the combined curvatures are not positive.
-
-    """
-    p = _check_positive('normal load', load)
-    curv_x = 1.0 / np.asarray(rolling_radius, dtype=float) \
-        + 1.0 / np.asarray(rail_longitudinal_radius, dtype=float)
-    curv_y = 1.0 / np.asarray(wheel_transverse_radius, dtype=float) \
-        + 1.0 / np.asarray(rail_transverse_radius, dtype=float)
-    a_cur, b_cur = np.broadcast_arrays(0.5 * curv_x, 0.5 * curv_y)
-    if np.any(~(a_cur > 0.0)) or np.any(~(b_cur > 0.0)):
-        raise ScenarioError('wheel-rail curvatures are invalid: the combined curvature along '
-                            'x and y must be > 0 (radii: positive convex, negative concave)')
-    p, a_cur, b_cur = np.broadcast_arrays(p, a_cur, b_cur)
-    small = np.minimum(a_cur, b_cur)
-    ratio = np.maximum(a_cur, b_cur) / small
-    # Vectorised bisection on log(g) for _curvature_ratio(g) = ratio (decreasing in g).
-    lo = np.full(ratio.shape, math.log(1e-6))
-    hi = np.zeros(ratio.shape)
-    for _ in range(64):
-        mid = 0.5 * (lo + hi)
-        too_round = _curvature_ratio(np.exp(mid)) < ratio
-        hi = np.where(too_round, mid, hi)
-        lo = np.where(too_round, lo, mid)
-    g = np.where(ratio <= 1.0 + 1e-12, 1.0, np.exp(0.5 * (lo + hi)))
-    m = 1.0 - g * g
-    k, e = ellipk(m), ellipe(m)
-    e_star = young_modulus / (2.0 * (1.0 - poisson_ratio ** 2))
-    # (K - E) / e^2 -> pi / 4 for a circle.
-    k_minus_e_over_m = np.where(m > 1e-10, (k - e) / np.where(m > 1e-10, m, 1.0),
-                                math.pi / 4.0)
-    major = (3.0 * p * k_minus_e_over_m / (2.0 * math.pi * e_star * small)) ** (1.0 / 3.0)
-    minor = g * major
-    p0 = 3.0 * p / (2.0 * math.pi * major * minor)
-    approach = p0 * minor * k / e_star
-    along_x_is_major = a_cur <= b_cur
-    a = np.where(along_x_is_major, major, minor)
-    b = np.where(along_x_is_major, minor, major)
-    return HertzEllipse(a=a, b=b, peak_pressure=p0, approach=approach,
-                        g_equivalent=approach / p ** (2.0 / 3.0))
-
-
 def kalker_coefficients(a_over_b: ArrayLike, poisson_ratio: float = POISSON_RATIO, *,
                         clip: bool = False) -> tuple[np.ndarray, np.ndarray, np.ndarray,
                                                      np.ndarray]:
@@ -394,20 +142,20 @@ def kalker_coefficients(a_over_b: ArrayLike, poisson_ratio: float = POISSON_RATI
 
     Raises
     ------
-    ScenarioError
+    ModelError
         If a/b is outside 0.1 .. 10 (and ``clip`` is False) or nu outside 0 .. 0.5.
 
     """
     r = np.asarray(a_over_b, dtype=float)
     lo, hi = KALKER_RATIO_RANGE
     if not 0.0 <= poisson_ratio <= 0.5:
-        raise ScenarioError(f'poisson_ratio = {poisson_ratio!r} is invalid; allowed: 0..0.5')
+        raise ModelError(f'poisson_ratio = {poisson_ratio!r} is invalid; allowed: 0..0.5')
     if clip:
         r = np.clip(r, lo, hi)
     elif np.any(~((r >= lo * (1 - 1e-12)) & (r <= hi * (1 + 1e-12)))):
         bad = r[~((r >= lo * (1 - 1e-12)) & (r <= hi * (1 + 1e-12)))].ravel()[0]
-        raise ScenarioError(f'contact ellipse a/b = {bad!r} is outside the Kalker table; '
-                            f'allowed: {lo}..{hi}')
+        raise ModelError(f'contact ellipse a/b = {bad!r} is outside the Kalker table; '
+                         f'allowed: {lo}..{hi}')
     s = np.where(r <= 1.0, r, 2.0 - 1.0 / np.where(r > 0.0, r, 1.0))
     out = []
     for key in ('c11', 'c22', 'c23'):
@@ -453,8 +201,8 @@ def creep_coefficients(a: ArrayLike, b: ArrayLike, *, young_modulus: float = YOU
         f11 (N), f22 (N), f23 (N m), f33 (N m^2).
 
     """
-    a = _check_positive('contact semi-axis a', a)
-    b = _check_positive('contact semi-axis b', b)
+    a = check_positive('contact semi-axis a', a)
+    b = check_positive('contact semi-axis b', b)
     c11, c22, c23, c33 = kalker_coefficients(a / b, poisson_ratio, clip=clip)
     shear = young_modulus / (2.0 * (1.0 + poisson_ratio))
     ab = a * b
@@ -490,125 +238,11 @@ def scale_creep_coefficients(coefficients: tuple[ArrayLike, ArrayLike, ArrayLike
         (f11, f22, f23, f33) at ``load``.
 
     """
-    _check_positive('reference load', reference_load)
+    check_positive('reference load', reference_load)
     ratio = np.maximum(np.asarray(load, dtype=float), 0.0) / reference_load
     f11, f22, f23, f33 = (np.asarray(c, dtype=float) for c in coefficients)
     e11, e22, e23, e33 = CREEP_LOAD_EXPONENTS
     return f11 * ratio ** e11, f22 * ratio ** e22, f23 * ratio ** e23, f33 * ratio ** e33
-
-
-@dataclass(frozen=True)
-class WheelsetGeometry:
-    """
-    Rolling radii and contact angles of the two wheels of wheelsets.
-
-    Attributes
-    ----------
-    rolling_radius : numpy.ndarray
-        Shape (..., 2): rolling radius of the left and right wheel (m).
-    contact_angle : numpy.ndarray
-        Shape (..., 2): contact angle of the left and right wheel (rad), > 0
-        when the normal on the wheel tilts towards the track centre.
-
-    """
-
-    rolling_radius: np.ndarray
-    contact_angle: np.ndarray
-
-
-def simplified_geometry(lateral: ArrayLike, conicity: float, nominal_radius: float = 0.46
-                        ) -> WheelsetGeometry:
-    """
-    Return the equivalent-cone contact geometry of PHYSICS.md section 2.3.
-
-    r_L = r0 + lambda_e y, r_R = r0 - lambda_e y (y to the left), and the contact
-    angle of both wheels is the cone angle arctan(lambda_e).
-
-    Parameters
-    ----------
-    lateral : array_like
-        Wheelset lateral displacement relative to the track y (m).
-    conicity : float
-        Equivalent conicity lambda_e (-), 0 .. 1.
-    nominal_radius : float
-        Nominal rolling radius r0 (m).
-
-    Returns
-    -------
-    WheelsetGeometry
-        Arrays of shape ``lateral.shape + (2,)``.
-
-    """
-    if not (math.isfinite(conicity) and 0.0 <= conicity <= 1.0):
-        raise ScenarioError(f'conicity = {conicity!r} is invalid; allowed: 0..1')
-    _check_positive('nominal rolling radius', nominal_radius)
-    y = np.asarray(lateral, dtype=float)
-    radius = np.stack([nominal_radius + conicity * y, nominal_radius - conicity * y], axis=-1)
-    angle = np.full(radius.shape, math.atan(conicity))
-    return WheelsetGeometry(rolling_radius=radius, contact_angle=angle)
-
-
-def creepages(speed: float, geometry: WheelsetGeometry, *, longitudinal_velocity: ArrayLike = 0.0,
-              lateral_velocity: ArrayLike = 0.0, yaw: ArrayLike = 0.0,
-              yaw_rate: ArrayLike = 0.0, spin_rate: ArrayLike = 0.0,
-              roll_rate: ArrayLike = 0.0, nominal_radius: float = 0.46,
-              semi_distance: float = 0.7465) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """
-    Return the creepages of the left and right wheel of wheelsets.
-
-    With side s = +1 (left) / -1 (right), rolling radius r_s, contact angle
-    gamma_s and nominal spin Omega = V / r0 (PHYSICS.md 2.3, in REP-103 axes):
-
-    * xi_x = (x' - r_s beta' - s b psi') / V + 1 - r_s / r0
-    * xi_y = (y' + r0 phi') / V - psi
-    * xi_sp = psi' cos(gamma_s) / V - s sin(gamma_s) / r0
-
-    where beta' is the spin perturbation rate (wheelset pitch DOF) and phi'
-    the roll rate.  With the equivalent cone (r_s = r0 + s lambda y,
-    gamma = lambda) and beta' = phi' = 0 these are PHYSICS.md's
-    xi_x = -s (lambda y / r0 + b psi' / V) (+ x'/V), xi_y = y'/V - psi and
-    xi_sp = psi'/V - s lambda / r0 up to the sign change of y and psi between
-    Zhai's axes and REP 103.
-
-    Parameters
-    ----------
-    speed : float
-        Train speed V (m/s), > 0.
-    geometry : WheelsetGeometry
-        Rolling radii and contact angles, shape (..., 2).
-    longitudinal_velocity, lateral_velocity : array_like
-        x' and y' of the wheelset (m/s).
-    yaw, yaw_rate : array_like
-        psi (rad) and psi' (rad/s) of the wheelset.
-    spin_rate, roll_rate : array_like
-        beta' and phi' of the wheelset (rad/s).
-    nominal_radius : float
-        r0 (m).
-    semi_distance : float
-        b, half the distance between the contact points (m).
-
-    Returns
-    -------
-    xi_x, xi_y, xi_sp : numpy.ndarray
-        Shape (..., 2) (left, right); xi_sp in 1/m.
-
-    """
-    if not (math.isfinite(speed) and speed > 0.0):
-        raise ScenarioError(f'speed = {speed!r} m/s is invalid; allowed: finite and > 0')
-    side = np.array([1.0, -1.0])
-    r = geometry.rolling_radius
-    gamma = geometry.contact_angle
-    xd = np.asarray(longitudinal_velocity, dtype=float)[..., None]
-    yd = np.asarray(lateral_velocity, dtype=float)[..., None]
-    psi = np.asarray(yaw, dtype=float)[..., None]
-    psid = np.asarray(yaw_rate, dtype=float)[..., None]
-    betad = np.asarray(spin_rate, dtype=float)[..., None]
-    phid = np.asarray(roll_rate, dtype=float)[..., None]
-    xi_x = (xd - r * betad - side * semi_distance * psid) / speed + 1.0 - r / nominal_radius
-    xi_y = (yd + nominal_radius * phid) / speed - psi
-    xi_sp = psid * np.cos(gamma) / speed - side * np.sin(gamma) / nominal_radius
-    xi_x, xi_y, xi_sp = np.broadcast_arrays(xi_x, xi_y, xi_sp)
-    return np.array(xi_x), np.array(xi_y), np.array(xi_sp)
 
 
 def linear_creep_forces(xi_x: ArrayLike, xi_y: ArrayLike, xi_sp: ArrayLike,
@@ -751,7 +385,7 @@ def she_saturation(fx: ArrayLike, fy: ArrayLike, mz: ArrayLike, normal: ArrayLik
 
     """
     if not (math.isfinite(friction) and 0.0 < friction <= 2.0):
-        raise ScenarioError(f'friction = {friction!r} is invalid; allowed: 0 < mu <= 2')
+        raise ModelError(f'friction = {friction!r} is invalid; allowed: 0 < mu <= 2')
     fx, fy, mz, n = np.broadcast_arrays(*(np.asarray(v, dtype=float)
                                           for v in (fx, fy, mz, normal)))
     f = np.hypot(fx, fy)

@@ -47,8 +47,7 @@ from scipy import signal
 from ttb_sim.model.irregularity.profile import check_variance, synthesize, VarianceCheck
 from ttb_sim.model.irregularity.spectra import SPECTRA
 from ttb_sim.model.vehicle import car
-from ttb_sim.model.wheel_rail.contact import (hertz_constant, linearised_stiffness,
-                                              static_compression)
+from ttb_sim.model.wheel_rail import hertz_constant, linearised_stiffness, static_compression
 from ttb_sim.validation.rows import Case, relative_row, Row
 
 #: Car body and bogies: the bodies left free in V4 (wheelsets held).
