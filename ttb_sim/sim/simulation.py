@@ -30,7 +30,7 @@ import numpy as np
 from ttb_sim.config.scenario import parse_observers, Scenario
 from ttb_sim.errors import DivergenceError, ScenarioError
 from ttb_sim.model.bridge import bearing_forces, build_structure, Structure
-from ttb_sim.model.irregularity.profile import load_csv, synthesize, TrackIrregularity
+from ttb_sim.model.irregularity import load_csv, synthesize, TrackIrregularity
 from ttb_sim.model.vehicle.train import build_vehicle, MovingForces, MultibodyCars, QuarterCars
 from ttb_sim.sim.coupling.quarter_car import QuarterCarCoupling
 from ttb_sim.sim.coupling.train_track import TrainTrackCoupling

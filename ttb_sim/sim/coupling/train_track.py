@@ -59,7 +59,7 @@ from ttb_sim.config.scenario import Scenario
 from ttb_sim.errors import DivergenceError
 from ttb_sim.fe.beam import point_rows
 from ttb_sim.model.bridge import Structure
-from ttb_sim.model.irregularity.profile import TrackIrregularity
+from ttb_sim.model.irregularity import TrackIrregularity
 from ttb_sim.model.track import BeamLine
 from ttb_sim.model.vehicle.car import (CarParameters, dofs as car_dofs, gyroscopic_matrix,
                                        train_matrices)
