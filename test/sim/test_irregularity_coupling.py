@@ -28,7 +28,7 @@ import numpy as np
 import pytest
 from ttb_sim.config import key_spec, load_scenario
 from ttb_sim.errors import ScenarioError
-from ttb_sim.model.irregularity.profile import available_spectra
+from ttb_sim.model.irregularity import available_spectra
 from ttb_sim.sim.simulation import Simulation
 
 

@@ -22,7 +22,7 @@ import pytest
 from ttb_sim.config import load_scenario
 from ttb_sim.errors import ScenarioError
 from ttb_sim.model.vehicle.car import dof
-from ttb_sim.model.wheel_rail import contact as ct
+import ttb_sim.model.wheel_rail as ct
 from ttb_sim.model.wheel_rail.profiles import contact_geometry_table
 from ttb_sim.sim.simulation import Simulation
 

@@ -29,7 +29,7 @@ import numpy as np
 from ttb_sim.config import parse_observers, Scenario
 from ttb_sim.errors import ScenarioError
 from ttb_sim.model.bridge import assemble_structure, Structure
-from ttb_sim.model.irregularity.profile import load_csv, synthesize, TrackIrregularity
+from ttb_sim.model.irregularity import load_csv, synthesize, TrackIrregularity
 from ttb_sim.model.vehicle.train import Axles, MovingForces, MultibodyCars, QuarterCars, Vehicle
 
 __all__ = ['build_irregularity', 'build_structure', 'build_vehicle', 'observer_rows',

@@ -30,7 +30,7 @@ import numpy as np
 from ttb_sim.config import parse_observers, Scenario
 from ttb_sim.errors import DivergenceError
 from ttb_sim.model.bridge import bearing_forces
-from ttb_sim.model.irregularity.profile import TrackIrregularity
+from ttb_sim.model.irregularity import TrackIrregularity
 from ttb_sim.model.vehicle.train import MovingForces, MultibodyCars, QuarterCars
 from ttb_sim.sim.build import build_irregularity, build_structure, build_vehicle, observer_rows
 from ttb_sim.sim.coupling.quarter_car import QuarterCarCoupling

@@ -29,7 +29,7 @@ import numpy as np
 import pytest
 from scipy import integrate
 
-from ttb_sim.errors import ScenarioError
+from ttb_sim.errors import ModelError
 from ttb_sim.model.irregularity import spectra
 
 TWO_PI = 2.0 * math.pi
@@ -113,9 +113,9 @@ def test_registry_names_and_components():
     for name in expected - {'sato'}:
         assert tuple(spectra.get_spectrum(name).components) == spectra.COMPONENTS
     assert len(ALL_COMPONENTS) == 37
-    with pytest.raises(ScenarioError, match='unknown irregularity spectrum .*chinese_hsr'):
+    with pytest.raises(ModelError, match='unknown irregularity spectrum .*chinese_hsr'):
         spectra.get_spectrum('chinese')
-    with pytest.raises(ScenarioError, match="no component 'gauge'"):
+    with pytest.raises(ModelError, match="no component 'gauge'"):
         spectra.get_spectrum('sato').component('gauge')
 
 
@@ -209,7 +209,7 @@ def test_sato_large_roughness_coefficient():
     assert smooth_at_1m == pytest.approx(1.05e-3, rel=0.02)
     chinese_at_1m = spectra.SPECTRA['chinese_hsr'].components['vertical'].psd(1.0) * 1e6
     assert smooth_at_1m / chinese_at_1m == pytest.approx(2.7, rel=0.02)
-    with pytest.raises(ScenarioError, match='roughness coefficient'):
+    with pytest.raises(ModelError, match='roughness coefficient'):
         spectra.sato_spectrum(-1.0)
 
 
@@ -252,5 +252,5 @@ def test_invalid_arguments_are_refused():
     comp = spectra.SPECTRA['chinese_hsr'].components['vertical']
     with pytest.raises(ValueError, match='> 0'):
         comp.psd([0.1, 0.0])
-    with pytest.raises(ScenarioError, match='wavelength band'):
+    with pytest.raises(ModelError, match='wavelength band'):
         comp.variance(10.0, 5.0)

@@ -28,7 +28,7 @@ import pytest
 
 from ttb_sim.errors import ModelError
 from ttb_sim.model.vehicle import car
-from ttb_sim.model.wheel_rail.contact import hertz_constant, linearised_stiffness
+from ttb_sim.model.wheel_rail import hertz_constant, linearised_stiffness
 
 UPPER = ('car_body', 'bogie_1', 'bogie_2')
 G = 9.81

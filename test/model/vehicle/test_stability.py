@@ -19,7 +19,7 @@ References: Klingel's kinematic wavelength L_K = 2 pi sqrt(r0 b / lambda)
 (PHYSICS.md 2.3); the time-domain measurements of the Table 1 car on the
 LMA/CHN60 table (no yaw dampers: grows at 300 km/h, decays at 200 km/h;
 default yaw dampers: decays at 300 and 400 km/h); central differences of the
-nonlinear contact laws, evaluated here with :mod:`ttb_sim.model.wheel_rail.contact` and
+nonlinear contact laws, evaluated here with :mod:`ttb_sim.model.wheel_rail` and
 the profile table, not with the analysis module.
 """
 
@@ -33,7 +33,7 @@ import scipy.linalg
 
 from ttb_sim.model.vehicle import stability as st
 from ttb_sim.model.vehicle.car import CarParameters, contact_map, N_DOF, wheelset_dofs
-from ttb_sim.model.wheel_rail import contact as ct
+import ttb_sim.model.wheel_rail as ct
 from ttb_sim.model.wheel_rail.profiles import contact_geometry_table
 
 KMH = 1.0 / 3.6
@@ -103,7 +103,7 @@ def nonlinear_contact_force(params: CarParameters, speed: float, q: np.ndarray,
     Return the generalised contact force on the car on rigid rails (independent evaluation).
 
     Uses the contact laws of the time-domain solver through
-    :mod:`ttb_sim.model.wheel_rail.contact` and the profile table directly: Hertz on
+    :mod:`ttb_sim.model.wheel_rail` and the profile table directly: Hertz on
     delta0 + height(y) - hz q, creepages of ``ct.creepages``, load-scaled
     Kalker coefficients and the lateral normal-force component.
     """

@@ -26,8 +26,8 @@ import math
 import numpy as np
 import pytest
 
-from ttb_sim.errors import ScenarioError
-from ttb_sim.model.wheel_rail import contact, profiles
+from ttb_sim.errors import ModelError
+from ttb_sim.model.wheel_rail import geometry, hertz, profiles
 
 
 @pytest.fixture(scope='module')
@@ -215,31 +215,31 @@ def test_lookup_is_vectorised(table):
     assert r[1, 1] == pytest.approx(table.rolling_radius[-1])
     geo = table.wheelset_geometry(np.zeros(4))
     assert geo.rolling_radius.shape == (4, 2)
-    xi_x, _, _ = contact.creepages(80.0, geo)
+    xi_x, _, _ = geometry.creepages(80.0, geo)
     assert xi_x.shape == (4, 2)
-    with pytest.raises(ScenarioError, match='column'):
+    with pytest.raises(ModelError, match='column'):
         table.lookup(0.0, 'radius')
-    with pytest.raises(ScenarioError, match='amplitude'):
+    with pytest.raises(ModelError, match='amplitude'):
         table.equivalent_conicity(0.05)
 
 
 def test_hertz_ellipse_from_table_curvatures(table):
     """The table's curvatures give a Hertz ellipse inside Kalker's a/b range on the tread."""
     mid = len(table.lateral) // 2
-    e = contact.hertz_ellipse(78.48e3, table.rolling_radius[mid, 0],
-                              1.0 / table.rail_curvature[mid, 0],
-                              wheel_transverse_radius=1.0 / table.wheel_curvature[mid, 0])
+    e = hertz.hertz_ellipse(78.48e3, table.rolling_radius[mid, 0],
+                            1.0 / table.rail_curvature[mid, 0],
+                            wheel_transverse_radius=1.0 / table.wheel_curvature[mid, 0])
     assert 0.1 < e.a / e.b < 10.0
     assert e.peak_pressure < 1.13e9       # conformal hollow tread lowers the pressure
 
 
 def test_invalid_parameters():
-    """Inconsistent or out-of-range dimensions raise ScenarioError naming the parameter."""
-    with pytest.raises(ScenarioError, match='tread_radius'):
+    """Inconsistent or out-of-range dimensions raise ModelError naming the parameter."""
+    with pytest.raises(ModelError, match='tread_radius'):
         profiles.WheelParameters(tread_radius=-1.0)
-    with pytest.raises(ScenarioError, match='crown_half_width'):
+    with pytest.raises(ModelError, match='crown_half_width'):
         profiles.RailParameters(crown_half_width=0.05)
-    with pytest.raises(ScenarioError, match='y_max'):
+    with pytest.raises(ModelError, match='y_max'):
         profiles.contact_geometry_table(y_max=0.1)
-    with pytest.raises(ScenarioError, match='n_points'):
+    with pytest.raises(ModelError, match='n_points'):
         profiles.contact_geometry_table(n_points=100)

@@ -12,4 +12,52 @@
 # See the License for the specific language governing permissions and
 # limitations under the License.
 
-"""irregularity: see the modules of this package."""
+"""
+Track irregularity: the public face of the modules of this package.
+
+- :mod:`.spectra`: spectrum families (Chinese HSR, Sato, German, FRA) and
+  their band integrals.
+- :mod:`.profile`: a realised profile on a grid (:class:`TrackIrregularity`)
+  and its sampling with derivatives.
+- :mod:`.synthesis`: random profiles from spectra, layers and presets.
+- :mod:`.measured`: measured profiles from CSV, and CSV output.
+- :mod:`.variance`: the V8/V10 variance check of the synthesis.
+"""
+
+from ttb_sim.model.irregularity.measured import CSV_COLUMNS, load_csv, MIN_CSV_ROWS, save_csv
+from ttb_sim.model.irregularity.profile import (IrregularitySample, RAIL_QUANTITIES,
+                                                TrackIrregularity)
+from ttb_sim.model.irregularity.spectra import (band_rms, band_variance, COMPONENTS,
+                                                CONTACT_SPACING, get_spectrum,
+                                                SATO_DEFAULT_ROUGHNESS, sato_spectrum, SPECTRA,
+                                                SpectrumComponent, SpectrumFamily)
+from ttb_sim.model.irregularity.synthesis import (available_spectra, IrregularityLayer,
+                                                  MIN_RECORD_WAVELENGTHS, PRESETS, synthesize)
+from ttb_sim.model.irregularity.variance import check_variance, VarianceCheck
+
+__all__ = [
+    'COMPONENTS',
+    'CONTACT_SPACING',
+    'CSV_COLUMNS',
+    'IrregularityLayer',
+    'IrregularitySample',
+    'MIN_CSV_ROWS',
+    'MIN_RECORD_WAVELENGTHS',
+    'PRESETS',
+    'RAIL_QUANTITIES',
+    'SATO_DEFAULT_ROUGHNESS',
+    'SPECTRA',
+    'SpectrumComponent',
+    'SpectrumFamily',
+    'TrackIrregularity',
+    'VarianceCheck',
+    'available_spectra',
+    'band_rms',
+    'band_variance',
+    'check_variance',
+    'get_spectrum',
+    'load_csv',
+    'sato_spectrum',
+    'save_csv',
+    'synthesize',
+]

@@ -41,7 +41,7 @@ Components are named ``vertical`` (mean vertical profile of the two rails),
 ``alignment`` (mean lateral position), ``cross_level`` (height of the left rail
 minus height of the right rail, m) and ``gauge`` (gauge widening, m).  How the
 four are combined into rail irregularities is defined in
-:mod:`ttb_sim.model.irregularity.profile`.
+:mod:`ttb_sim.model.irregularity.synthesis`.
 
 Each component has a default wavelength band (its range of validity, or the
 band used by the source).  ``psd`` is nevertheless defined for every n > 0 so
@@ -65,7 +65,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy import integrate
 
-from ttb_sim.errors import ScenarioError
+from ttb_sim.errors import ModelError
 
 __all__ = [
     'COMPONENTS',
@@ -182,7 +182,7 @@ class SpectrumComponent:
 
         Raises
         ------
-        ScenarioError
+        ModelError
             If the band is empty or not positive.
 
         """
@@ -192,7 +192,7 @@ class SpectrumComponent:
             message = (
                 f'{self.label}: wavelength band must satisfy 0 < wavelength_min < '
                 f'wavelength_max, got {lo} m and {hi} m')
-            raise ScenarioError(message)
+            raise ModelError(message)
         return lo, hi
 
     def variance(
@@ -326,7 +326,7 @@ class SpectrumFamily:
 
         Raises
         ------
-        ScenarioError
+        ModelError
             If this family has no such component.
 
         """
@@ -336,7 +336,7 @@ class SpectrumFamily:
             message = (
                 f'spectrum {self.name!r} has no component {name!r}; '
                 f'it has {", ".join(self.components)}')
-            raise ScenarioError(message) from None
+            raise ModelError(message) from None
 
 
 # --- Chinese HSR ballastless track, TB/T 3352-2014 (PHYSICS.md 1.1) -----------------------
@@ -418,7 +418,7 @@ def sato_spectrum(
     Source form S(Omega) = A / Omega^3 (m^2/(rad/m), one-sided, Omega in rad/m),
     so that G(n) = 2 pi S(2 pi n) = A / (4 pi^2 n^3).  It has a ``vertical``
     component only; the synthesis adds it to the mean vertical profile, i.e.
-    identically to both rails (see :mod:`ttb_sim.model.irregularity.profile`).
+    identically to both rails (see :mod:`ttb_sim.model.irregularity.synthesis`).
 
     Parameters
     ----------
@@ -437,13 +437,13 @@ def sato_spectrum(
 
     Raises
     ------
-    ScenarioError
+    ModelError
         If the coefficient is not a positive finite number.
 
     """
     a = float(roughness_coefficient)
     if not (math.isfinite(a) and a > 0.0):
-        raise ScenarioError(f'Sato roughness coefficient must be > 0, got {roughness_coefficient}')
+        raise ModelError(f'Sato roughness coefficient must be > 0, got {roughness_coefficient}')
     scale = a / _TWO_PI**2
 
     def density(n: NDArray[np.float64]) -> NDArray[np.float64]:
@@ -583,7 +583,7 @@ def get_spectrum(name: str | SpectrumFamily) -> SpectrumFamily:
 
     Raises
     ------
-    ScenarioError
+    ModelError
         If the name is unknown; the message lists the known names.
 
     """
@@ -593,7 +593,7 @@ def get_spectrum(name: str | SpectrumFamily) -> SpectrumFamily:
         return SPECTRA[name]
     except (KeyError, TypeError):
         message = f'unknown irregularity spectrum {name!r}; known: {", ".join(SPECTRA)}'
-        raise ScenarioError(message) from None
+        raise ModelError(message) from None
 
 
 def band_variance(

@@ -651,7 +651,7 @@ class ContactMap:
     The generalised car force from contact forces (Fx, Fy, Fz, Mz) acting on
     the wheels is ``hx.T @ Fx + hy.T @ Fy + hz.T @ Fz + hyaw.T @ Mz``.  The
     velocity form of the same rows gives the creepage terms of
-    :func:`ttb_sim.model.wheel_rail.contact.creepages`.  The simplified map of PHYSICS.md
+    :func:`ttb_sim.model.wheel_rail.geometry.creepages`.  The simplified map of PHYSICS.md
     (lateral motion y_w only) is ``hy`` without the r0 roll term.
 
     Attributes

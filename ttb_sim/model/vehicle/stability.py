@@ -104,7 +104,7 @@ from ttb_sim.errors import ScenarioError
 from ttb_sim.model.vehicle.car import (CarParameters, contact_map, damping_matrix, DOF_PER_BODY,
                                        dofs as car_dofs, gyroscopic_matrix, mass_matrix, N_BODIES,
                                        N_DOF, stiffness_matrix, WHEELSETS)
-from ttb_sim.model.wheel_rail import contact as ct
+import ttb_sim.model.wheel_rail as ct
 from ttb_sim.model.wheel_rail.profiles import contact_geometry_table, ContactGeometryTable
 
 log = logging.getLogger(__name__)

@@ -68,8 +68,8 @@ import math
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ttb_sim.errors import ScenarioError
-from ttb_sim.model.wheel_rail.contact import WheelsetGeometry
+from ttb_sim.errors import ModelError
+from ttb_sim.model.wheel_rail.geometry import WheelsetGeometry
 
 
 @dataclass(frozen=True)
@@ -164,8 +164,8 @@ def _line(t0: float, t1: float, h0: float, slope: float) -> _Segment:
 
 def _check(name: str, value: float, lo: float, hi: float) -> None:
     if not (isinstance(value, (int, float)) and math.isfinite(value) and lo < value < hi):
-        raise ScenarioError(f'profile parameter {name} = {value!r} is invalid; '
-                            f'allowed: {lo} < value < {hi}')
+        raise ModelError(f'profile parameter {name} = {value!r} is invalid; '
+                         f'allowed: {lo} < value < {hi}')
 
 
 @dataclass(frozen=True)
@@ -313,8 +313,8 @@ def rail_profile(params: RailParameters | None = None) -> Profile:
     # The corner arc ends vertical at the head half-width: c3_u + r3 = half width.
     s2 = (p.head_half_width - r3 - c2[0]) / (r2 - r3)
     if not 0.0 < s2 < 1.0 or math.asin(s2) <= th1:
-        raise ScenarioError('rail profile parameters are inconsistent: the R80 arc cannot join '
-                            'the crown and the corner within the head half-width')
+        raise ModelError('rail profile parameters are inconsistent: the R80 arc cannot join '
+                         'the crown and the corner within the head half-width')
     th2 = math.asin(s2)
     c3 = (c2[0] + (r2 - r3) * math.sin(th2), c2[1] + (r2 - r3) * math.cos(th2))
     th3 = p.corner_end_angle
@@ -376,8 +376,8 @@ def wheel_profile(params: WheelParameters | None = None) -> Profile:
     qc = ct * ct + k0 * k0 - (rt - rf) ** 2
     disc = qb * qb - 4.0 * qa * qc
     if disc <= 0.0:
-        raise ScenarioError('wheel profile parameters are inconsistent: the flange root arc '
-                            'cannot touch both the tread arc and the flange face')
+        raise ModelError('wheel profile parameters are inconsistent: the flange root arc '
+                         'cannot touch both the tread arc and the flange face')
     cr_t = (-qb + math.sqrt(disc)) / (2.0 * qa)
     cr_h = hf + m * (cr_t - yf) - rf * root
     # Tangent points: root/tread along the line of centres, root/face by projection.
@@ -390,8 +390,8 @@ def wheel_profile(params: WheelParameters | None = None) -> Profile:
     ci_t = yf + (ci_h - hf - ri * root) / m
     y_tf = ci_t + ri * m / root
     if not (ci_t < y_tf < y_rf < y_rt < 0.0 < p.outer_tread_start):
-        raise ScenarioError('wheel profile parameters are inconsistent: arcs and flange face '
-                            'do not follow each other from the flange tip to the tread')
+        raise ModelError('wheel profile parameters are inconsistent: arcs and flange face '
+                         'do not follow each other from the flange tip to the tread')
     y_o = p.outer_tread_start
     h_o = ch + math.sqrt(rt * rt - (y_o - ct) ** 2)
     s_o = -(y_o - ct) / math.sqrt(rt * rt - (y_o - ct) ** 2)
@@ -483,8 +483,8 @@ class ContactGeometryTable:
         columns = ('roll', 'rise', 'rolling_radius', 'contact_angle', 'wheel_position',
                    'rail_position', 'contact_y', 'wheel_curvature', 'rail_curvature')
         if name not in columns:
-            raise ScenarioError(f'contact table column {name!r} is unknown; '
-                                f'allowed: {", ".join(columns)}')
+            raise ModelError(f'contact table column {name!r} is unknown; '
+                             f'allowed: {", ".join(columns)}')
         return self._interp(y, getattr(self, name))
 
     def wheelset_geometry(self, y: ArrayLike) -> WheelsetGeometry:
@@ -499,7 +499,7 @@ class ContactGeometryTable:
         Returns
         -------
         WheelsetGeometry
-            For :func:`ttb_sim.model.wheel_rail.contact.creepages`.
+            For :func:`ttb_sim.model.wheel_rail.geometry.creepages`.
 
         """
         return WheelsetGeometry(rolling_radius=self._interp(y, self.rolling_radius),
@@ -573,8 +573,8 @@ class ContactGeometryTable:
         """
         y_max = float(self.lateral[-1])
         if not (math.isfinite(amplitude) and 0.0 < amplitude <= y_max):
-            raise ScenarioError(f'conicity amplitude = {amplitude!r} m is invalid; '
-                                f'allowed: 0 < amplitude <= {y_max}')
+            raise ModelError(f'conicity amplitude = {amplitude!r} m is invalid; '
+                             f'allowed: 0 < amplitude <= {y_max}')
         dr = self.radius_difference(np.array([amplitude, -amplitude]))
         return float(0.5 * (dr[0] / (2.0 * amplitude) + dr[1] / (-2.0 * amplitude)))
 
@@ -597,8 +597,8 @@ def _rail_points(rail: Profile, rp: RailParameters, step: float) -> tuple[np.nda
     y_gauge = np.interp(-rp.gauge_depth, zi[order], yi[order])
     y = y - y_gauge + 0.5 * rp.gauge
     if np.any(np.diff(y) <= 0.0):
-        raise ScenarioError('rail profile is not single-valued after cant; reduce '
-                            'corner_end_angle or the cant')
+        raise ModelError('rail profile is not single-valued after cant; reduce '
+                         'corner_end_angle or the cant')
     return y, z, u
 
 
@@ -649,19 +649,19 @@ def contact_geometry_table(wheel: WheelParameters | None = None,
 
     Raises
     ------
-    ScenarioError
+    ModelError
         On invalid arguments or if the roll iteration does not converge.
 
     """
     wp = wheel or WheelParameters()
     rp = rail or RailParameters()
     if not (math.isfinite(y_max) and 0.0 < y_max <= 0.03):
-        raise ScenarioError(f'y_max = {y_max!r} m is invalid; allowed: 0 < y_max <= 0.03')
+        raise ModelError(f'y_max = {y_max!r} m is invalid; allowed: 0 < y_max <= 0.03')
     if isinstance(n_points, bool) or not isinstance(n_points, int) \
             or not (11 <= n_points <= 2001 and n_points % 2 == 1):
-        raise ScenarioError(f'n_points = {n_points!r} is invalid; allowed: odd integer 11..2001')
+        raise ModelError(f'n_points = {n_points!r} is invalid; allowed: odd integer 11..2001')
     if not (math.isfinite(step) and 1e-6 <= step <= 1e-4):
-        raise ScenarioError(f'step = {step!r} m is invalid; allowed: 1e-6..1e-4')
+        raise ModelError(f'step = {step!r} m is invalid; allowed: 1e-6..1e-4')
     wprof = wheel_profile(wp)
     rprof = rail_profile(rp)
     b = wp.taping_semi_distance
@@ -705,7 +705,7 @@ def contact_geometry_table(wheel: WheelParameters | None = None,
             break
         phi = phi - f / (gap_rate(phi, i_left, 1.0) - gap_rate(phi, i_right, -1.0))
     else:
-        raise ScenarioError('contact geometry: the wheelset roll iteration did not converge')
+        raise ModelError('contact geometry: the wheelset roll iteration did not converge')
     d_left, i_left = gaps(phi, 1.0)
     d_right, i_right = gaps(phi, -1.0)
     zc = -0.5 * (d_left + d_right)

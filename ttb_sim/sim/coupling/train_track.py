@@ -59,10 +59,10 @@ from ttb_sim.config import Scenario
 from ttb_sim.errors import DivergenceError
 from ttb_sim.fe.beam import point_rows
 from ttb_sim.model.bridge import Structure
-from ttb_sim.model.irregularity.profile import TrackIrregularity
+from ttb_sim.model.irregularity import TrackIrregularity
 from ttb_sim.model.track import BeamLine
 from ttb_sim.model.vehicle.car import dofs as car_dofs, gyroscopic_matrix, train_matrices
-from ttb_sim.model.wheel_rail import contact as ct
+import ttb_sim.model.wheel_rail as ct
 from ttb_sim.model.wheel_rail.profiles import contact_geometry_table
 from ttb_sim.sim.integrators.newmark import Newmark
 

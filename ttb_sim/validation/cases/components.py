@@ -17,8 +17,8 @@ Component validation cases V4, V5, V8, V9 and V10 (VALIDATION.md).
 
 Every number comes from the package code a simulation uses: the car matrices
 and their eigen-analysis (:mod:`ttb_sim.model.vehicle.car`), the Hertz contact law
-(:mod:`ttb_sim.model.wheel_rail.contact`) and the irregularity synthesis
-(:mod:`ttb_sim.model.irregularity.profile`, :mod:`ttb_sim.model.irregularity.spectra`).  Only the
+(:mod:`ttb_sim.model.wheel_rail`) and the irregularity synthesis
+(:mod:`ttb_sim.model.irregularity`).  Only the
 post-processing (naming modes by their shape, Welch PSD per octave band) is
 written here.
 
@@ -44,11 +44,9 @@ import math
 import numpy as np
 from scipy import signal
 
-from ttb_sim.model.irregularity.profile import check_variance, synthesize, VarianceCheck
-from ttb_sim.model.irregularity.spectra import SPECTRA
+from ttb_sim.model.irregularity import check_variance, SPECTRA, synthesize, VarianceCheck
 from ttb_sim.model.vehicle import car
-from ttb_sim.model.wheel_rail.contact import (hertz_constant, linearised_stiffness,
-                                              static_compression)
+from ttb_sim.model.wheel_rail import hertz_constant, linearised_stiffness, static_compression
 from ttb_sim.validation.rows import Case, relative_row, Row
 
 #: Car body and bogies: the bodies left free in V4 (wheelsets held).
@@ -194,7 +192,7 @@ def _label(family: str, component: str, n_components: int) -> str:
 
 def variance_checks(seeds: int = ENSEMBLE_SEEDS) -> dict[str, list[VarianceCheck]]:
     """
-    Run :func:`ttb_sim.model.irregularity.profile.check_variance` on every component.
+    Run :func:`ttb_sim.model.irregularity.variance.check_variance` on every component.
 
     Parameters
     ----------

@@ -1,0 +1,232 @@
+# Copyright 2026 The ttb_sim Authors
+#
+# Licensed under the Apache License, Version 2.0 (the "License");
+# you may not use this file except in compliance with the License.
+# You may obtain a copy of the License at
+#
+#     http://www.apache.org/licenses/LICENSE-2.0
+#
+# Unless required by applicable law or agreed to in writing, software
+# distributed under the License is distributed on an "AS IS" BASIS,
+# WITHOUT WARRANTIES OR CONDITIONS OF ANY KIND, either express or implied.
+# See the License for the specific language governing permissions and
+# limitations under the License.
+
+"""
+Measured rail irregularity profiles: CSV read (:func:`load_csv`) and write.
+
+The file has a header row naming at least :data:`CSV_COLUMNS` (x along the
+track, then the rail irregularities with the signs of :mod:`.profile`), one
+row per position.  A refused user file raises
+:class:`~ttb_sim.errors.ScenarioError` naming the file and the row; a bad
+argument (``dx``) raises :class:`~ttb_sim.errors.ModelError`.
+"""
+
+from __future__ import annotations
+
+import csv
+import logging
+import math
+import operator
+from os import PathLike
+from pathlib import Path
+
+import numpy as np
+from scipy.interpolate import CubicSpline
+
+from ttb_sim.errors import ScenarioError
+from ttb_sim.model.irregularity._checks import check_positive, GRID_SLACK
+from ttb_sim.model.irregularity.profile import RAIL_QUANTITIES, TrackIrregularity
+
+__all__ = [
+    'CSV_COLUMNS',
+    'MIN_CSV_ROWS',
+    'load_csv',
+    'save_csv',
+]
+
+_LOG = logging.getLogger(__name__)
+
+#: Columns a measured-profile CSV must have (any order; others are ignored).
+CSV_COLUMNS: tuple[str, ...] = ('x', *RAIL_QUANTITIES)
+
+#: Fewest data rows accepted from a CSV (a cubic spline needs four).
+MIN_CSV_ROWS: int = 4
+
+
+def save_csv(irregularity: TrackIrregularity, path: str | PathLike[str]) -> None:
+    """
+    Write the grid values of a profile as CSV readable by :func:`load_csv`.
+
+    Parameters
+    ----------
+    irregularity : TrackIrregularity
+        Profile to write; values are written with 17 significant digits.
+    path : str or os.PathLike
+        Output file.
+
+    Raises
+    ------
+    ScenarioError
+        If the file cannot be written.
+
+    """
+    table = np.column_stack([irregularity.x, irregularity.values.T])
+    try:
+        np.savetxt(path, table, fmt='%.17g', delimiter=',', header=','.join(CSV_COLUMNS),
+                   comments='')
+    except OSError as exc:
+        raise ScenarioError(f'{path}: cannot write irregularity file: {exc}') from None
+
+
+def _refuse(path: str | PathLike[str], row: int | None, problem: str) -> ScenarioError:
+    where = f'{path}' if row is None else f'{path}: row {row}'
+    return ScenarioError(f'{where}: {problem}')
+
+
+def load_csv(
+    path: str | PathLike[str],
+    *,
+    min_length: float | None = None,
+    dx: float | None = None,
+) -> TrackIrregularity:
+    """
+    Load a measured rail irregularity profile from CSV.
+
+    The file has a header row naming at least the columns ``x, z_left,
+    z_right, y_left, y_right`` (any order; other columns are ignored), then one
+    row per position: x along the track (m, strictly increasing) and the rail
+    irregularities (m, signs as in :mod:`.profile`).  Blank lines and
+    lines starting with ``#`` are skipped.  Row numbers in messages are line
+    numbers of the file, counting from 1 (the header is usually row 1).
+
+    A not-a-knot cubic spline through the data gives slopes and curvatures.
+    If the rows are uniformly spaced (relative spread of the spacing below
+    1e-6) and ``dx`` is not given, the grid is the rows themselves and the
+    values are kept exactly; otherwise the spline is resampled onto a uniform
+    grid of spacing ``dx`` (default: the median spacing of the rows) starting
+    at the first x.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        CSV file.
+    min_length : float, optional
+        Length (m) the profile must cover, x_last - x_first.
+    dx : float, optional
+        Spacing (m) of the uniform grid to resample onto.
+
+    Returns
+    -------
+    TrackIrregularity
+        The profile.
+
+    Raises
+    ------
+    ScenarioError
+        If the file cannot be read, a required column is missing, a row has
+        the wrong number of fields or a non-numeric / non-finite value, x does
+        not strictly increase, there are fewer than ``MIN_CSV_ROWS`` rows, or
+        the profile is shorter than ``min_length``.  The message names the
+        file and the row.
+    ModelError
+        If ``dx`` is given and is not a finite number > 0.
+
+    """
+    try:
+        text = Path(path).read_text(encoding='utf-8-sig')
+    except (OSError, UnicodeDecodeError) as exc:
+        raise _refuse(path, None, f'cannot read irregularity file ({exc})') from None
+    lines = text.splitlines()
+    rows = list(csv.reader(lines))
+    if len(rows) != len(lines):   # a quoted field spanning lines
+        raise _refuse(path, None, 'unbalanced quotes; cannot parse as CSV')
+    stripped = np.char.strip(np.array(lines, dtype=str)) if lines else np.array([], dtype=str)
+    content = np.flatnonzero((stripped != '') & ~np.char.startswith(stripped, '#'))
+    if content.size == 0:
+        raise _refuse(path, 1, f'no header; expected columns {", ".join(CSV_COLUMNS)}')
+
+    header_index = int(content[0])
+    header = [name.strip() for name in rows[header_index]]
+    missing = [name for name in CSV_COLUMNS if name not in header]
+    if missing:
+        message = (
+            f'header is missing column(s) {", ".join(missing)}; '
+            f'expected {", ".join(CSV_COLUMNS)}, found {", ".join(header)}')
+        raise _refuse(path, header_index + 1, message)
+    duplicated = sorted({name for name in CSV_COLUMNS if header.count(name) > 1})
+    if duplicated:
+        raise _refuse(path, header_index + 1, f'duplicated column(s) {", ".join(duplicated)}')
+
+    data_index = content[1:]
+    row_numbers = data_index + 1
+    if data_index.size < MIN_CSV_ROWS:
+        last = f'last data row {row_numbers[-1]}' if data_index.size else 'no data rows'
+        message = (
+            f'too few rows: {data_index.size} data row(s) ({last}), need at least '
+            f'{MIN_CSV_ROWS}')
+        raise _refuse(path, int(row_numbers[-1]) if data_index.size else header_index + 1,
+                      message)
+    widths = np.fromiter(map(len, rows), dtype=np.intp, count=len(rows))[data_index]
+    wrong = np.flatnonzero(widths != len(header))
+    if wrong.size:
+        r = wrong[0]
+        message = f'expected {len(header)} fields as in the header, found {widths[r]}'
+        raise _refuse(path, int(row_numbers[r]), message)
+    table = np.array(operator.itemgetter(*data_index)(rows), dtype=str)
+    cells = np.char.strip(table[:, [header.index(name) for name in CSV_COLUMNS]])
+    try:
+        numbers = cells.astype(np.float64)
+    except ValueError:
+        parsed = np.frompyfunc(_parses_as_float, 1, 1)(cells).astype(bool)
+        r, c = np.argwhere(~parsed)[0]
+        message = f'non-numeric value {str(cells[r, c])!r} in column {CSV_COLUMNS[c]}'
+        raise _refuse(path, int(row_numbers[r]), message) from None
+    bad = np.argwhere(~np.isfinite(numbers))
+    if bad.size:
+        r, c = bad[0]
+        message = f'value {str(cells[r, c])!r} in column {CSV_COLUMNS[c]} is not a finite number'
+        raise _refuse(path, int(row_numbers[r]), message)
+
+    x = numbers[:, 0]
+    rails = numbers[:, 1:].T
+    steps = np.diff(x)
+    decreasing = np.flatnonzero(steps <= 0.0)
+    if decreasing.size:
+        r = decreasing[0] + 1
+        message = (
+            f'x = {x[r]:g} m does not increase strictly (previous data row {row_numbers[r - 1]} '
+            f'has x = {x[r - 1]:g} m)')
+        raise _refuse(path, int(row_numbers[r]), message)
+    covered = x[-1] - x[0]
+    if min_length is not None and covered < float(min_length) * (1.0 - GRID_SLACK):
+        message = (
+            f'profile too short: it covers {covered:g} m (x = {x[0]:g} to {x[-1]:g} m, last '
+            f'data row {row_numbers[-1]}), {float(min_length):g} m is needed')
+        raise _refuse(path, int(row_numbers[-1]), message)
+
+    spacing = float(np.median(steps))
+    uniform = bool(np.max(np.abs(steps - spacing)) <= 1e-6 * spacing)
+    spline = CubicSpline(x, rails, axis=1)
+    if dx is None and uniform:
+        grid_dx = covered / (x.size - 1)
+        values = rails
+        grid = x
+    else:
+        grid_dx = spacing if dx is None else check_positive('dx', dx)
+        grid = x[0] + grid_dx * np.arange(int(math.floor(covered / grid_dx + GRID_SLACK)) + 1)
+        if grid.size < 2:
+            raise _refuse(path, None, f'dx = {grid_dx:g} m is longer than the profile')
+        values = spline(grid)
+        _LOG.info('%s: resampled %d rows onto %d points at dx = %g m',
+                  path, x.size, grid.size, grid_dx)
+    return TrackIrregularity(
+        float(x[0]), grid_dx, values, spline(grid, 1), spline(grid, 2), source=f'csv:{path}')
+
+
+def _parses_as_float(cell: str) -> bool:
+    try:
+        float(cell)
+    except ValueError:
+        return False
+    return True
