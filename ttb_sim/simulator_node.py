@@ -62,7 +62,7 @@ from rosidl_runtime_py.utilities import get_message
 from std_msgs.msg import ColorRGBA, Header
 from std_srvs.srv import SetBool, Trigger
 from ttb_sim.config import load_scenario
-from ttb_sim.errors import ScenarioError
+from ttb_sim.errors import ModelError, ScenarioError
 from ttb_sim.io.bag import BagRecorder, default_bag_path
 from ttb_sim.io.topics import FRAME_ID, topic_table
 from ttb_sim.node import (DEFAULT_SCENARIO, initial_values, markers, MarkerSet, NodeParameter,
@@ -155,7 +155,7 @@ class SimulatorNode(Node):
         self.controller: PassageController | None = None
         try:
             self._configure()
-        except ScenarioError:
+        except (ScenarioError, ModelError):
             self.close()
             self.destroy_node()
             raise
@@ -363,7 +363,7 @@ def main(args: list[str] | None = None) -> int:
         executor.spin()
     except (KeyboardInterrupt, ExternalShutdownException):
         pass
-    except ScenarioError as exc:
+    except (ScenarioError, ModelError) as exc:
         get_logger('ttb_sim').fatal(str(exc))
         code = 2
     finally:
