@@ -35,6 +35,7 @@ from ttb_sim.scenario import parse_observers, Scenario
 from ttb_sim.sim.frames import Frame, Layout
 from ttb_sim.sim.newmark import Newmark
 from ttb_sim.sim.ttbi import TrainTrackCoupling
+from ttb_sim.sim.variants import blas_threads, solver_variant
 from ttb_sim.sim.vbi import QuarterCarCoupling
 
 log = logging.getLogger(__name__)
@@ -218,13 +219,16 @@ class Simulation:
             n_bodies, n_axles = 0, 1
         self.layout = Layout(n_spans=scenario.bridge.n_spans, n_supports=st.n_supports,
                              n_bodies=n_bodies, n_axles=n_axles, observers=names)
-        self.integrator = Newmark(st.mass, st.damping, st.stiffness, dt)
-        self.coupling = (QuarterCarCoupling(self.vehicle, st.girder, self.integrator,
-                                            st.n_free)
-                         if isinstance(self.vehicle, QuarterCars) else None)
-        self.train_track = (TrainTrackCoupling(scenario, st, self.integrator,
-                                               self.irregularity)
-                            if isinstance(self.vehicle, MultibodyCars) else None)
+        self.variant = solver_variant(scenario.solver.variant)
+        with blas_threads(self.variant.blas_threads):
+            self.integrator = Newmark(st.mass, st.damping, st.stiffness, dt,
+                                      method=self.variant.factorization)
+            self.coupling = (QuarterCarCoupling(self.vehicle, st.girder, self.integrator,
+                                                st.n_free)
+                             if isinstance(self.vehicle, QuarterCars) else None)
+            self.train_track = (TrainTrackCoupling(scenario, st, self.integrator,
+                                                   self.irregularity)
+                                if isinstance(self.vehicle, MultibodyCars) else None)
         log.info('model: %d free DOFs, %d axles, dt = %.3g s, %d steps', st.n_free,
                  self.vehicle.axles.count, dt, self.n_steps)
 
@@ -250,6 +254,8 @@ class Simulation:
 
         :attr:`speed` is read at every step, so a caller may change it while
         iterating (the ROS node does); the number of steps stays as planned.
+        The BLAS threads are limited as the solver variant says while the
+        generator runs.
 
         Raises
         ------
@@ -258,6 +264,10 @@ class Simulation:
             every frame before the failure has already been yielded.
 
         """
+        with blas_threads(self.variant.blas_threads):
+            yield from self._frames()
+
+    def _frames(self) -> Iterator[Frame]:
         if self.train_track is not None:
             yield from self._car_frames()
             return

@@ -53,10 +53,10 @@ import logging
 import math
 
 import numpy as np
-import scipy.sparse.linalg as sla
 
 from ttb_sim.errors import DivergenceError
 from ttb_sim.fe.beam import point_rows
+from ttb_sim.fe.factorization import factorize
 from ttb_sim.model import contact as ct
 from ttb_sim.model.bridge import Structure
 from ttb_sim.model.car import CarParameters, dofs as car_dofs, gyroscopic_matrix, train_matrices
@@ -327,7 +327,7 @@ class TrainTrackCoupling:
         irr_z = irr_z + self._geometry(-irr_y)[2]
         n_free = st.n_free
         m = 8 * n
-        lu = sla.splu(st.stiffness.tocsc())
+        lu = factorize(st.stiffness, method=self.nm.method)
         rhs = np.zeros((n_free + 1, m))
         flat = dofs.reshape(m, 12)
         rz = rows[..., 2, :].reshape(m, 12)
