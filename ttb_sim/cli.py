@@ -72,6 +72,22 @@ def _parser() -> argparse.ArgumentParser:
     val.add_argument('cases', nargs='*', metavar='CASE', help='case ids (default: all)')
     val.add_argument('--list', action='store_true', help='list the cases and exit')
 
+    be = sub.add_parser('bench', help='time the solver variants side by side and compare '
+                        'their results with the reference variant')
+    be.add_argument('scenarios', nargs='*', metavar='SCENARIO',
+                    help='YAML paths or built-in names (default: ten_span_train, and '
+                    'paper_ttbi for 0.05 s)')
+    be.add_argument('--duration', type=float, help='simulated time of every scenario (s)')
+    be.add_argument('--variants', help='comma-separated solver.variant values (default: all; '
+                    'reference always runs, as the comparison base)')
+    be.add_argument('--json', type=Path, metavar='FILE', help='also write the report as JSON')
+    be.add_argument('--repeat', type=int, default=1, help='interleaved rounds; the fastest '
+                    'run of each variant is kept (default 1)')
+    be.add_argument('--in-process', action='store_true', help='run every variant in this '
+                    'process (peak memory is then not per run)')
+    be.add_argument('--set', dest='overrides', action='append', default=[],
+                    metavar='KEY=VALUE', help='override a scenario key; repeatable')
+
     sc = sub.add_parser('scenarios', help='list the built-in scenarios')
     sc.add_argument('--keys', action='store_true',
                     help='list every scenario key with unit, default and range')
@@ -89,6 +105,8 @@ def main(argv: Sequence[str] | None = None) -> int:
             return _cmd_run(args)
         if args.command == 'validate':
             return _cmd_validate(args)
+        if args.command == 'bench':
+            return _cmd_bench(args)
         return _cmd_scenarios(args)
     except ScenarioError as exc:
         print(f'ttb-sim: error: {exc}', file=sys.stderr)
@@ -158,6 +176,19 @@ def _cmd_validate(args: argparse.Namespace) -> int:
     failed = sum(not r.passed for r in rows)
     print(f'{len(rows) - failed} passed, {failed} failed')
     return EXIT_OK if failed == 0 else EXIT_FAILURE
+
+
+def _cmd_bench(args: argparse.Namespace) -> int:
+    from ttb_sim.commands.bench import bench, format_table, write_json
+
+    variants = [v.strip() for v in (args.variants or '').split(',') if v.strip()]
+    report = bench(args.scenarios, variants, args.duration, overrides=args.overrides,
+                   repeat=args.repeat, isolate=not args.in_process,
+                   progress=lambda line: print(f'bench: {line}', file=sys.stderr))
+    print(format_table(report))
+    if args.json is not None:
+        write_json(report, args.json)
+    return EXIT_OK
 
 
 def _cmd_scenarios(args: argparse.Namespace) -> int:
