@@ -222,7 +222,8 @@ class Simulation:
         self.variant = solver_variant(scenario.solver.variant)
         with blas_threads(self.variant.blas_threads):
             self.integrator = Newmark(st.mass, st.damping, st.stiffness, dt,
-                                      method=self.variant.factorization)
+                                      method=self.variant.factorization,
+                                      lean=self.variant.lean)
             self.coupling = (QuarterCarCoupling(self.vehicle, st.girder, self.integrator,
                                                 st.n_free)
                              if isinstance(self.vehicle, QuarterCars) else None)
