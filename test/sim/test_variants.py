@@ -18,6 +18,7 @@ import numpy as np
 import pytest
 import scipy.sparse as sp
 from ttb_sim.scenario import key_spec, load_scenario, Scenario
+from ttb_sim.sim.lean import MovingLoad
 from ttb_sim.sim.newmark import Newmark
 from ttb_sim.sim.simulation import Simulation
 from ttb_sim.sim.variants import blas_threads, solver_variant, VARIANTS
@@ -75,3 +76,16 @@ def test_blas_threads_limit_applies_inside_the_block():
         assert all(i['num_threads'] == 1 for i in infos)
     with blas_threads(None):
         pass
+
+
+def test_lean_moving_load_equals_the_general_assembly():
+    sc = load_scenario('ten_span_train', [], [('solver.variant', 'reference')])
+    sim = Simulation(sc)
+    st = sim.structure
+    lean = MovingLoad(st.girder, sim.vehicle.loads, st.n_free, st.n_full)
+    for head in (0.0, 17.3, 160.0, 321.9, 500.0):
+        positions = head - sim.vehicle.axles.offsets
+        full = sim._moving_load(positions)
+        scale = np.max(np.abs(full)) or 1.0
+        assert np.max(np.abs(lean.full(positions) - full)) <= 1e-14 * scale
+        assert np.max(np.abs(lean(positions) - full[st.free])) <= 1e-14 * scale

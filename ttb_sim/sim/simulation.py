@@ -33,6 +33,7 @@ from ttb_sim.model.irregularity import load_csv, synthesize, TrackIrregularity
 from ttb_sim.model.vehicle import build_vehicle, MovingForces, MultibodyCars, QuarterCars
 from ttb_sim.scenario import parse_observers, Scenario
 from ttb_sim.sim.frames import Frame, Layout
+from ttb_sim.sim.lean import MovingLoad
 from ttb_sim.sim.newmark import Newmark
 from ttb_sim.sim.ttbi import TrainTrackCoupling
 from ttb_sim.sim.variants import blas_threads, solver_variant
@@ -282,10 +283,16 @@ class Simulation:
         a = nm.initial_acceleration(u, v, load_full[st.free])
         yield self._frame(0, head, u, v, a, load_full)
         zero = np.zeros(n_free)
+        lean_load = (MovingLoad(st.girder, self.vehicle.loads, n_free, st.n_full)
+                     if self.variant.lean and isinstance(self.vehicle, MovingForces) else None)
         for step in range(1, self.n_steps + 1):
             head += self.speed * dt
             positions = head - offsets
-            if self.coupling is None:
+            if lean_load is not None:
+                u, v, a = nm.step(u, v, a, lean_load(positions))
+                if step % self.output_every == 0:
+                    load_full = lean_load.full(positions)
+            elif self.coupling is None:
                 load_full = self._moving_load(positions)
                 u, v, a = nm.step(u, v, a, load_full[st.free])
             else:
