@@ -77,12 +77,14 @@ def test_unknown_method_and_non_square_are_refused():
         fz.factorize(sp.csc_matrix(np.ones((2, 3))))
 
 
-def test_missing_package_falls_back_to_scipy(monkeypatch, caplog):
+def test_missing_package_falls_back_to_the_other_wheel_then_scipy(monkeypatch, caplog):
+    monkeypatch.setattr(fz, 'available', lambda method: method != 'cholmod')
+    assert fz.factorize(_spd(), method='cholmod').method == 'qdldl'
     monkeypatch.setattr(fz, 'available', lambda method: method not in ('cholmod', 'qdldl'))
     a = _spd()
     with caplog.at_level(logging.WARNING, logger=fz.__name__):
         f = fz.factorize(a, method='cholmod')
-    assert f.method == fz.FALLBACK
+    assert f.method == 'superlu_sym'
     assert 'cholespy' in caplog.text
     b = np.ones(a.shape[0])
     assert np.allclose(a @ f.solve(b), b, rtol=0, atol=1e-12)

@@ -27,16 +27,18 @@ once and then solved for many right-hand sides. The methods:
 ``cholmod``
     CHOLMOD's supernodal Cholesky (fill-reducing AMD order) through the
     ``cholespy`` wheel, which bundles its own single-threaded reference BLAS.
-    The fastest solve measured here (README, Benchmark).
+    The fastest solve in isolation and with many right-hand sides.
 ``qdldl``
     QDLDL's LDL^T with AMD order through the ``qdldl`` wheel: cheap to
-    factorise, one right-hand side at a time.
+    factorise, one right-hand side at a time; the fastest inside the time
+    step (README, Benchmark).
 
-The symmetric methods read the lower triangle and need a symmetric positive
+The symmetric methods read one triangle and need a symmetric positive
 definite (``cholmod``) or quasi-definite (``qdldl``, ``superlu_sym``) matrix;
 :func:`factorize` checks symmetry to round-off. When the package of a method is
-not installed, :func:`factorize` falls back to ``superlu_sym`` with a warning,
-so a plain scipy installation runs every variant.
+not installed, :func:`factorize` falls back to the other wheel, else to
+``superlu_sym``, with a warning, so a plain scipy installation runs every
+variant.
 
 Every method is deterministic: the same matrix and right-hand side give the
 same bits on every call and every run.
@@ -56,8 +58,8 @@ log = logging.getLogger(__name__)
 
 METHODS = ('superlu', 'superlu_sym', 'cholmod', 'qdldl')
 """Names accepted by :func:`factorize`."""
-FALLBACK = 'superlu_sym'
-"""Method used when the package of the requested one is missing."""
+FALLBACKS = ('qdldl', 'cholmod', 'superlu_sym')
+"""Symmetric methods in order of preference when the requested one's package is missing."""
 SYMMETRY_TOLERANCE = 1e-12
 """Largest |A - A^T| accepted by the symmetric methods, relative to max |A|."""
 _PACKAGES = {'cholmod': 'cholespy', 'qdldl': 'qdldl'}
@@ -92,7 +94,9 @@ def resolve(method: str) -> str:
     if method not in METHODS:
         message = f'unknown factorisation method {method!r}; allowed: {", ".join(METHODS)}'
         raise ValueError(message)
-    return method if available(method) else FALLBACK
+    if available(method):
+        return method
+    return next(m for m in FALLBACKS if available(m))
 
 
 def factorize(matrix: sp.spmatrix | sp.sparray, *, method: str = 'superlu') -> Factorization:
@@ -105,7 +109,7 @@ def factorize(matrix: sp.spmatrix | sp.sparray, *, method: str = 'superlu') -> F
         The matrix; symmetric (to round-off) for every method but ``superlu``.
     method : str
         One of :data:`METHODS`. A method whose package is missing falls back
-        to :data:`FALLBACK` (logged as a warning).
+        to the first available of :data:`FALLBACKS` (logged as a warning).
 
     Returns
     -------
