@@ -32,7 +32,11 @@ setup(
     ],
     python_requires='>=3.10',
     install_requires=['setuptools', 'numpy>=1.24', 'scipy>=1.10', 'rosbags>=0.10',
-                      'PyYAML>=6', 'tqdm>=4.60'],
+                      'PyYAML>=6', 'tqdm>=4.60',
+                      # solver.variant (README, Benchmark); each is optional at run time:
+                      # without it the variants fall back to scipy / leave BLAS threads as
+                      # they are.
+                      'cholespy>=2.0', 'qdldl>=0.1.7', 'threadpoolctl>=3'],
     extras_require={
         'test': ['pytest>=7', 'mcap>=1.1', 'mcap-ros2-support>=0.5', 'flake8>=6',
                  'flake8-quotes', 'flake8-import-order', 'flake8-builtins',

@@ -61,6 +61,22 @@ def _parser() -> argparse.ArgumentParser:
     val.add_argument('cases', nargs='*', metavar='CASE', help='case ids (default: all)')
     val.add_argument('--list', action='store_true', help='list the cases and exit')
 
+    be = sub.add_parser('bench', help='time the solver variants side by side and compare '
+                        'their results with the reference variant')
+    be.add_argument('scenarios', nargs='*', metavar='SCENARIO',
+                    help='YAML paths or built-in names (default: ten_span_train, and '
+                    'paper_ttbi for 0.05 s)')
+    be.add_argument('--duration', type=float, help='simulated time of every scenario (s)')
+    be.add_argument('--variants', help='comma-separated solver.variant values (default: all; '
+                    'reference always runs, as the comparison base)')
+    be.add_argument('--json', type=Path, metavar='FILE', help='also write the report as JSON')
+    be.add_argument('--repeat', type=int, default=1, help='interleaved rounds; the fastest '
+                    'run of each variant is kept (default 1)')
+    be.add_argument('--in-process', action='store_true', help='run every variant in this '
+                    'process (peak memory is then not per run)')
+    be.add_argument('--set', dest='overrides', action='append', default=[],
+                    metavar='KEY=VALUE', help='override a scenario key; repeatable')
+
     sc = sub.add_parser('scenarios', help='list the built-in scenarios')
     sc.add_argument('--keys', action='store_true',
                     help='list every scenario key with unit, default and range')
@@ -82,6 +98,12 @@ def main(argv: Sequence[str] | None = None) -> int:
         if args.command == 'validate':
             from ttb_sim.commands.validate import validate
             return validate(args.cases, list_only=args.list)
+        if args.command == 'bench':
+            from ttb_sim.commands.bench import bench_command
+            return bench_command(args.scenarios, variants=args.variants,
+                                 duration=args.duration, json_path=args.json,
+                                 repeat=args.repeat, isolate=not args.in_process,
+                                 overrides=args.overrides)
         from ttb_sim.commands.scenarios import scenarios
         return scenarios(keys=args.keys)
     except (ScenarioError, ModelError) as exc:

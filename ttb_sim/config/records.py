@@ -138,6 +138,13 @@ class SolverConfig:
     divergence_limit: float = param(10.0, 'm', 'Any displacement larger than this (or not '
                                     'finite) stops the run as diverged.', low=0.0, high=1e6,
                                     low_inclusive=False)
+    variant: str = param('qdldl', '-', "Solver variant: 'reference' is the validated path "
+                         '(general SuperLU LU, step as written); the others factorise the '
+                         'symmetric effective matrices with a fill-reducing order and take the '
+                         "lean step: 'qdldl' (LDL^T, the fastest measured), 'cholmod' "
+                         "(CHOLMOD Cholesky via cholespy), 'superlu_sym' (pure scipy). They "
+                         "agree with 'reference' to round-off (README, Benchmark).",
+                         choices=('qdldl', 'cholmod', 'superlu_sym', 'reference'))
 
 
 @dataclass(frozen=True)

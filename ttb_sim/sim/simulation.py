@@ -37,6 +37,8 @@ from ttb_sim.sim.coupling.quarter_car import QuarterCarCoupling
 from ttb_sim.sim.coupling.train_track import TrainTrackCoupling
 from ttb_sim.sim.frames import Frame, Layout
 from ttb_sim.sim.integrators.newmark import Newmark
+from ttb_sim.sim.lean import MovingLoad
+from ttb_sim.sim.variants import blas_threads, solver_variant
 
 log = logging.getLogger(__name__)
 
@@ -140,13 +142,17 @@ class Simulation:
             n_bodies, n_axles = 0, 1
         self.layout = Layout(n_spans=scenario.bridge.n_spans, n_supports=st.n_supports,
                              n_bodies=n_bodies, n_axles=n_axles, observers=names)
-        self.integrator = Newmark(st.mass, st.damping, st.stiffness, dt)
-        self.coupling = (QuarterCarCoupling(self.vehicle, st.girder, self.integrator,
-                                            st.n_free)
-                         if isinstance(self.vehicle, QuarterCars) else None)
-        self.train_track = (TrainTrackCoupling(scenario, st, self.integrator,
-                                               self.irregularity)
-                            if isinstance(self.vehicle, MultibodyCars) else None)
+        self.variant = solver_variant(scenario.solver.variant)
+        with blas_threads(self.variant.blas_threads):
+            self.integrator = Newmark(st.mass, st.damping, st.stiffness, dt,
+                                      method=self.variant.factorization,
+                                      lean=self.variant.lean)
+            self.coupling = (QuarterCarCoupling(self.vehicle, st.girder, self.integrator,
+                                                st.n_free)
+                             if isinstance(self.vehicle, QuarterCars) else None)
+            self.train_track = (TrainTrackCoupling(scenario, st, self.integrator,
+                                                   self.irregularity)
+                                if isinstance(self.vehicle, MultibodyCars) else None)
         log.info('model: %d free DOFs, %d axles, dt = %.3g s, %d steps', st.n_free,
                  self.vehicle.axles.count, dt, self.n_steps)
 
@@ -172,6 +178,8 @@ class Simulation:
 
         :attr:`speed` is read at every step, so a caller may change it while
         iterating (the ROS node does); the number of steps stays as planned.
+        The BLAS threads are limited as the solver variant says while the
+        generator runs.
 
         Raises
         ------
@@ -180,6 +188,10 @@ class Simulation:
             every frame before the failure has already been yielded.
 
         """
+        with blas_threads(self.variant.blas_threads):
+            yield from self._frames()
+
+    def _frames(self) -> Iterator[Frame]:
         if self.train_track is not None:
             yield from self._car_frames()
             return
@@ -193,10 +205,16 @@ class Simulation:
         a = nm.initial_acceleration(u, v, load_full[st.free])
         yield self._frame(0, head, u, v, a, load_full)
         zero = np.zeros(n_free)
+        lean_load = (MovingLoad(st.girder, self.vehicle.loads, n_free, st.n_full)
+                     if self.variant.lean and isinstance(self.vehicle, MovingForces) else None)
         for step in range(1, self.n_steps + 1):
             head += self.speed * dt
             positions = head - offsets
-            if self.coupling is None:
+            if lean_load is not None:
+                u, v, a = nm.step(u, v, a, lean_load(positions))
+                if step % self.output_every == 0:
+                    load_full = lean_load.full(positions)
+            elif self.coupling is None:
                 load_full = self._moving_load(positions)
                 u, v, a = nm.step(u, v, a, load_full[st.free])
             else:

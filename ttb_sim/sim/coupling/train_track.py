@@ -53,11 +53,11 @@ import logging
 import math
 
 import numpy as np
-import scipy.sparse.linalg as sla
 
 from ttb_sim.config import Scenario
 from ttb_sim.errors import DivergenceError
 from ttb_sim.fe.beam import point_rows
+from ttb_sim.fe.factorization import factorize
 from ttb_sim.model.bridge import Structure
 from ttb_sim.model.irregularity import TrackIrregularity
 from ttb_sim.model.track import BeamLine
@@ -74,6 +74,16 @@ COMPONENTS = 4
 """Contact force components per wheel: Fx, Fy, Fz (on the wheel), Mz (spin moment)."""
 GEOMETRY_STEP = 1e-6
 """Lateral step (m) of the central difference of the rigid-contact wheel height."""
+
+
+def gather(vector: np.ndarray, index: np.ndarray) -> np.ndarray:
+    """
+    Return ``vector`` extended by one zero (the ground slot) at extended free indices.
+
+    Equal to ``np.append(vector, 0.0)[index]`` without copying the whole vector.
+    """
+    n = vector.shape[0]
+    return np.where(index < n, vector[np.minimum(index, n - 1)], 0.0)
 
 
 @dataclass(frozen=True)
@@ -213,22 +223,25 @@ class TrainTrackCoupling:
                    ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         """Return rail-head rows R, R' (n_cars, 8, 3, 12), ext-free DOFs and B blocks."""
         shape = x.shape
-        rows = np.zeros(shape + (3, 12))
-        slope = np.zeros(shape + (3, 12))
+        xi = np.zeros(shape)
+        length = np.zeros(shape)
         dofs = np.zeros(shape + (12,), dtype=int)
         blocks = np.zeros(shape + (12, 12))
         for r, side in enumerate((1.0, -1.0)):
             sel = self.side == side
             rail = self.rails[r]
-            element, xi, inside = rail.locate(x[sel])
+            element, xi[sel], inside = rail.locate(x[sel])
             if not np.all(inside):
                 raise DivergenceError('a wheel ran off the modelled track at x = '
                                       f'{x[sel][~inside][0]:.2f} m; the run is longer than '
                                       'the track (check solver.duration)')
-            rows[sel] = point_rows(xi, rail.length[element], self.head_arm)
-            slope[sel] = point_rows(xi, rail.length[element], self.head_arm, 1)
+            length[sel] = rail.length[element]
             dofs[sel] = self.rail_dofs[r][element]
             blocks[sel] = self.compliance.blocks[r][element]
+        # Rows of both rails in one evaluation (elementwise, so the same numbers).
+        rows = point_rows(xi.ravel(), length.ravel(), self.head_arm).reshape(shape + (3, 12))
+        slope = point_rows(xi.ravel(), length.ravel(), self.head_arm, 1).reshape(
+            shape + (3, 12))
         return rows, slope, dofs, blocks
 
     def _irregularity(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -300,7 +313,7 @@ class TrainTrackCoupling:
         irr_z = irr_z + self._geometry(-irr_y)[2]
         n_free = st.n_free
         m = 8 * n
-        lu = sla.splu(st.stiffness.tocsc())
+        lu = factorize(st.stiffness, method=self.nm.method)
         rhs = np.zeros((n_free + 1, m))
         flat = dofs.reshape(m, 12)
         rz = rows[..., 2, :].reshape(m, 12)
@@ -400,11 +413,10 @@ class TrainTrackCoupling:
         # Predictors (no contact force).
         h_v, h_a = nm.history(self.u, self.v, self.a)
         u_star = nm.solve(nm.effective_load(np.zeros(n_free), h_v, h_a))
-        ue = np.append(u_star, 0.0)
-        hve = np.append(h_v, 0.0)
-        r_star = np.einsum('cwij,cwj->cwi', rows, ue[dofs])
-        rs_star = np.einsum('cwij,cwj->cwi', slope, ue[dofs])
-        r_hist = np.einsum('cwij,cwj->cwi', rows, hve[dofs])
+        u_dofs = gather(u_star, dofs)
+        r_star = np.einsum('cwij,cwj->cwi', rows, u_dofs)
+        rs_star = np.einsum('cwij,cwj->cwi', slope, u_dofs)
+        r_hist = np.einsum('cwij,cwj->cwi', rows, gather(h_v, dofs))
         a0, a1 = nm.a0, nm.a1
         qh_v = -a1 * self.q - self.qv
         qh_a = -a0 * self.q - 2.0 * a1 * self.qv - self.qa
@@ -471,9 +483,11 @@ class TrainTrackCoupling:
                 rv = rvp - np.einsum('cij,cj->ci', rail_vel, g)
                 # Contact geometry at the end-of-step lateral position.
                 y_rel = y_star + np.einsum('wj,cj->cw', self.ey, g) - value(r, 1) - irr_y
-                radius, angle, height = self._geometry(y_rel)
-                _, angle_hi, height_hi = self._geometry(y_rel + GEOMETRY_STEP)
-                _, angle_lo, height_lo = self._geometry(y_rel - GEOMETRY_STEP)
+                # Geometry at y and y +/- GEOMETRY_STEP in one (elementwise) evaluation.
+                radii, angles, heights = self._geometry(
+                    np.stack([y_rel, y_rel + GEOMETRY_STEP, y_rel - GEOMETRY_STEP]))
+                radius, angle, angle_hi, angle_lo = radii[0], angles[0], angles[1], angles[2]
+                height, height_hi, height_lo = heights
                 height_slope = (height_hi - height_lo) / (2 * GEOMETRY_STEP)
                 tan_slope = (np.tan(angle_hi) - np.tan(angle_lo)) / (2 * GEOMETRY_STEP)
                 cosg, sing, tan_g = np.cos(angle), np.sin(angle), np.tan(angle)
@@ -519,8 +533,7 @@ class TrainTrackCoupling:
             load = np.zeros(n_free + 1)
             np.add.at(load, dofs.ravel(), -np.einsum('cwij,cwi->cwj', rows, gx).ravel())
             u_new = u_star + nm.solve(load[:n_free])
-            ue = np.append(u_new, 0.0)
-            r_exact = np.einsum('cwij,cwj->cwi', rows, ue[dofs])
+            r_exact = np.einsum('cwij,cwj->cwi', rows, gather(u_new, dofs))
             r_model = rp.reshape(n, 8, COMPONENTS)[..., :3] - np.einsum(
                 'cwij,cwj->cwi', dr, gx)
             mismatch = r_exact - r_model

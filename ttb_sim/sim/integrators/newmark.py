@@ -19,6 +19,7 @@ from __future__ import annotations
 import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as sla
+from ttb_sim.fe.factorization import factorize
 
 
 class Newmark:
@@ -36,11 +37,18 @@ class Newmark:
         System matrices (n x n).
     dt : float
         Time step (s).
+    method : str
+        Factorisation of the effective matrix (:func:`ttb_sim.fe.factorization.factorize`);
+        the default ``superlu`` is the validated reference.
+    lean : bool
+        Lean step: :meth:`history` writes into one preallocated vector (valid
+        until its next call) and :meth:`effective_load` applies M and C as one
+        stacked sparse matrix (one mat-vec); equal to round-off.
 
     """
 
     def __init__(self, mass: sp.spmatrix, damping: sp.spmatrix, stiffness: sp.spmatrix,
-                 dt: float) -> None:
+                 dt: float, *, method: str = 'superlu', lean: bool = False) -> None:
         self.dt = float(dt)
         self.a0 = 4.0 / dt**2
         self.a1 = 2.0 / dt
@@ -48,7 +56,16 @@ class Newmark:
         self.damping = sp.csr_matrix(damping)
         self.stiffness = sp.csr_matrix(stiffness)
         effective = (self.stiffness + self.a1 * self.damping + self.a0 * self.mass).tocsc()
-        self._lu = sla.splu(effective)
+        self._lu = factorize(effective, method=method)
+        self.method = self._lu.method
+        """The factorisation method in use (after any fallback)."""
+        self.lean = lean
+        if lean:
+            n = self.mass.shape[0]
+            self._stacked = sp.hstack([self.mass, self.damping], format='csr')
+            self._history = np.zeros(2 * n)
+            self._h_a, self._h_v = self._history[:n], self._history[n:]
+            self._work = np.zeros(n)
 
     def history(self, u: np.ndarray, v: np.ndarray,
                 a: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -56,14 +73,26 @@ class Newmark:
         Return (h_v, h_a) with v_{n+1} = a1 u_{n+1} + h_v and a_{n+1} = a0 u_{n+1} + h_a.
 
         These express the end-of-step velocity and acceleration through the
-        unknown end-of-step displacement.
+        unknown end-of-step displacement. With ``lean`` the two are views of one
+        work vector, overwritten by the next call.
         """
+        if self.lean:
+            h_a, h_v, work = self._h_a, self._h_v, self._work
+            np.multiply(u, -self.a1, out=h_v)
+            h_v -= v
+            np.multiply(u, -self.a0, out=h_a)
+            np.multiply(v, 2.0 * self.a1, out=work)
+            h_a -= work
+            h_a -= a
+            return h_v, h_a
         h_v = -self.a1 * u - v
         h_a = -self.a0 * u - 2.0 * self.a1 * v - a
         return h_v, h_a
 
     def effective_load(self, force: np.ndarray, h_v: np.ndarray, h_a: np.ndarray) -> np.ndarray:
         """Return the right-hand side f_{n+1} - M h_a - C h_v of the effective system."""
+        if self.lean and h_a is self._h_a and h_v is self._h_v:
+            return force - self._stacked @ self._history
         return force - self.mass @ h_a - self.damping @ h_v
 
     def solve(self, rhs: np.ndarray) -> np.ndarray:
