@@ -68,13 +68,13 @@ def test_static_start_on_irregular_track():
                              ('output.rate_hz', 0.0)])
     frames = list(sim.frames())
     first, second = (f.wheel_rail[0, :, :, 2] for f in frames[:2])
-    assert np.max(np.abs(second - first)) < 0.05 * sim.train_track.p0
+    assert np.max(np.abs(second - first)) < 0.05 * sim.coupling.p0
 
 
 def test_static_equilibrium_satisfies_hertz():
     """The static start's loads are Hertz's law of its compressions (77.4 um at P0, LM)."""
     sim = small_car(0.01)
-    tt = sim.train_track
+    tt = sim.coupling
     tt.equilibrium(sim.scenario.train.start_position)
     np.testing.assert_allclose(ct.normal_force(tt.compression, tt.g_hertz), tt.force[..., 2],
                                rtol=1e-9)
@@ -108,7 +108,7 @@ def test_mean_lateral_force_of_a_centred_wheel_is_the_closed_form():
     sim = small_car(0.2, [('track.fastener_lateral_stiffness', 3e9),
                           ('track.rail_foot_width', 0.5)])
     wr = np.array([f.wheel_rail[0] for f in sim.frames()])
-    tt = sim.train_track
+    tt = sim.coupling
     gamma0 = float(contact_geometry_table().lookup(0.0, 'contact_angle')[0])
     f23 = tt.creep0[2]
     spin = -f23 * (-np.sin(gamma0) / tt.r0)
@@ -121,7 +121,7 @@ def test_mean_lateral_force_of_a_centred_wheel_is_the_closed_form():
 
 def test_contact_forces_satisfy_hertz_on_the_exact_track_response():
     sim = small_car(0.02, [('irregularity.spectrum', 'paper'), ('irregularity.seed', 3)])
-    tt = sim.train_track
+    tt = sim.coupling
     for _ in sim.frames():
         pass
     x = sim.scenario.train.start_position + sim.speed * sim.n_steps * sim.dt + tt.contact_x
@@ -150,7 +150,7 @@ def test_flange_contact_converges_and_pushes_the_wheelset_back():
     the right wheel stays on its tread (|Y/Q| < 0.1) and the wheelset moves back.
     """
     sim = small_car(0.01)
-    tt = sim.train_track
+    tt = sim.coupling
     frames = sim.frames()
     next(frames)
     shift = 0.0096

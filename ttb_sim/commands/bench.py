@@ -99,11 +99,7 @@ def _dof_counts(sim: Any) -> dict[str, int]:
         lines = (*st.track.rails, st.track.slab, st.track.base)
         full = np.unique(np.concatenate([line.dofs.ravel() for line in lines]))
         track = int(np.count_nonzero(st.full_to_free[full] < st.n_free))
-    vehicle = 0
-    if sim.train_track is not None:
-        vehicle = int(sim.train_track.q.size)
-    elif sim.coupling is not None:
-        vehicle = int(np.size(sim.coupling.z))
+    vehicle = sum(int(np.size(x)) for x in sim.coupling.monitored()[1:])
     return {'structure': st.n_free, 'track': track, 'bridge': st.n_free - track,
             'vehicle': vehicle, 'total': st.n_free + vehicle}
 

@@ -22,17 +22,14 @@ their declarations (keys, types, ranges) and builds them from plain data, and
 
 from ttb_sim.config.loader import (apply_overrides, builtin_scenarios, config_dirs, load_scenario,
                                    parse_override, read_yaml, resolve)
-from ttb_sim.config.records import (BearingParameters, BridgeParameters, ContactConfig,
-                                    FoundationParameters, IrregularityConfig, Observer,
-                                    OBSERVER_COMPONENTS, OutputConfig, parse_observers,
-                                    PierParameters, Scenario, SolverConfig, TrackParameters,
+from ttb_sim.config.records import (IrregularityConfig, Observer, OBSERVER_COMPONENTS,
+                                    OutputConfig, parse_observers, Scenario, SolverConfig,
                                     TrainConfig)
 from ttb_sim.config.schema import from_mapping, iter_keys, key_spec, to_plain
 from ttb_sim.parameters import param, Spec
 
-__all__ = ['apply_overrides', 'BearingParameters', 'BridgeParameters', 'builtin_scenarios',
-           'config_dirs', 'ContactConfig', 'FoundationParameters', 'from_mapping',
+__all__ = ['apply_overrides', 'builtin_scenarios', 'config_dirs', 'from_mapping',
            'IrregularityConfig', 'iter_keys', 'key_spec', 'load_scenario', 'Observer',
            'OBSERVER_COMPONENTS', 'OutputConfig', 'param', 'parse_observers',
-           'parse_override', 'PierParameters', 'read_yaml', 'resolve', 'Scenario',
-           'SolverConfig', 'Spec', 'to_plain', 'TrackParameters', 'TrainConfig']
+           'parse_override', 'read_yaml', 'resolve', 'Scenario', 'SolverConfig', 'Spec',
+           'to_plain', 'TrainConfig']

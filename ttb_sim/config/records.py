@@ -17,8 +17,11 @@ The scenario records: one frozen dataclass per section, each key declared once.
 
 A scenario is a tree of these records (:class:`Scenario` at the root).  Every
 leaf is declared with :func:`~ttb_sim.parameters.param` (default, unit, range
-or choices, description); the car section is the model's own car record
-(:class:`~ttb_sim.model.vehicle.car.CarParameters`).  Rules that involve more
+or choices, description). The sections the model consumes are the model's own
+records: car (:class:`~ttb_sim.model.vehicle.car.CarParameters`), track, bridge,
+bearings, piers, foundation (``model/track.py``, ``model/bridge.py``) and contact
+(``model/wheel_rail/parameters.py``); the rest (train, irregularity, solver,
+output) are declared here.  Rules that involve more
 than one key are checked when a :class:`Scenario` is made.
 """
 
@@ -36,6 +39,7 @@ from ttb_sim.model.bridge import (BearingParameters, BridgeParameters, Foundatio
                                   PierParameters)
 from ttb_sim.model.track import TrackParameters
 from ttb_sim.model.vehicle.car import CarParameters
+from ttb_sim.model.wheel_rail.parameters import ContactParameters
 from ttb_sim.parameters import param
 
 
@@ -104,26 +108,6 @@ class IrregularityConfig:
 
 
 @dataclass(frozen=True)
-class ContactConfig:
-    """Wheel-rail contact of multibody cars (PHYSICS.md section 2)."""
-
-    tread: str = param('lm', '-', "Zhai's Hertz constant: worn 'lm' or 'conical' tread.",
-                       choices=('lm', 'conical'))
-    friction: float = param(0.3, '-', 'Friction coefficient of the Shen-Hedrick-Elkins '
-                            'saturation.', low=0.0, high=1.0, low_inclusive=False)
-    geometry: str = param('profiles', '-', "'profiles': LMA wheel on CHN60 rail contact "
-                          "table; 'conicity': equivalent cone.",
-                          choices=('profiles', 'conicity'))
-    conicity: float = param(0.05, '-', "Equivalent conicity for geometry = 'conicity'.",
-                            low=0.0, high=1.0)
-    tolerance: float = param(1e-9, 'm', 'Convergence tolerance of the contact iteration on '
-                             'the compression of every wheel.', low=1e-15, high=1e-3,
-                             low_inclusive=False)
-    max_iterations: int = param(30, '-', 'Contact iterations per step before the run stops '
-                                'as diverged.', low=1, high=1000)
-
-
-@dataclass(frozen=True)
 class SolverConfig:
     """Time integration (Newmark average acceleration)."""
 
@@ -169,7 +153,7 @@ class Scenario:
     train: TrainConfig = field(default_factory=TrainConfig)
     car: CarParameters = field(default_factory=CarParameters)
     track: TrackParameters = field(default_factory=TrackParameters)
-    contact: ContactConfig = field(default_factory=ContactConfig)
+    contact: ContactParameters = field(default_factory=ContactParameters)
     bridge: BridgeParameters = field(default_factory=BridgeParameters)
     bearings: BearingParameters = field(default_factory=BearingParameters)
     piers: PierParameters = field(default_factory=PierParameters)

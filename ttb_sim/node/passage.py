@@ -187,7 +187,7 @@ class PassageController:
                 value = normalize_value(param, value)
             self.values[name] = value
             if name == 'train.speed_kmh':
-                self.sim.speed = value / 3.6
+                self.sim.set_speed(value / 3.6)
             elif name == 'real_time_factor':   # the new pace counts from now
                 self._anchor = (self._clock(), self._node_time)
             elif name == 'publish_rate_hz':

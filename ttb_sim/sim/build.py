@@ -22,7 +22,7 @@ out of the scenario once and hands each model builder what it needs.
 
 from __future__ import annotations
 
-from dataclasses import replace
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -31,8 +31,14 @@ from ttb_sim.errors import ScenarioError
 from ttb_sim.model.bridge import assemble_structure, Structure
 from ttb_sim.model.irregularity import load_csv, synthesize, TrackIrregularity
 from ttb_sim.model.vehicle.train import Axles, MovingForces, MultibodyCars, QuarterCars, Vehicle
+from ttb_sim.sim.coupling.base import Coupling
+from ttb_sim.sim.coupling.moving_force import MovingForceCoupling
+from ttb_sim.sim.coupling.quarter_car import QuarterCarTrain
+from ttb_sim.sim.coupling.train_track import TrainTrackCoupling
+from ttb_sim.sim.integrators.protocol import Integrator
 
-__all__ = ['build_irregularity', 'build_structure', 'build_vehicle', 'observer_rows',
+__all__ = ['build_coupling', 'build_irregularity', 'build_structure', 'build_vehicle',
+           'CONTACT_STEP', 'observer_rows', 'StepLimits', 'vehicle_track_setup',
            'PROFILE_MARGIN', 'train_length']
 
 
@@ -66,6 +72,72 @@ def build_vehicle(scenario: Scenario) -> Vehicle:
                        unsprung_mass=np.full(n, train.unsprung_mass),
                        stiffness=np.full(n, train.suspension_stiffness),
                        damping=np.full(n, train.suspension_damping))
+
+
+CONTACT_STEP = 1e-4
+"""Largest automatic time step with wheel-rail contact (s), the step of [P]."""
+
+
+@dataclass(frozen=True)
+class StepLimits:
+    """What the vehicle model asks of the automatic time step."""
+
+    element_length: float
+    """Shortest element a wheel load crosses (m): girder, or rail with a slab track."""
+    vehicle_frequency: float | None
+    """Highest vehicle frequency to resolve (Hz), or None."""
+    max_step: float | None
+    """Largest step the coupling allows (s), or None."""
+
+
+def vehicle_track_setup(scenario: Scenario, structure: Structure,
+                        vehicle: Vehicle) -> tuple[StepLimits, TrackIrregularity | None]:
+    """
+    Return the vehicle's time-step limits and the irregularity it runs on.
+
+    Moving forces ignore the irregularity; quarter cars follow it over the part of
+    the track the train covers; multibody cars run on it over the whole modelled
+    track and ask for the contact step.
+    """
+    girder = structure.girder
+    if isinstance(vehicle, QuarterCars):
+        irregularity = build_irregularity(scenario, vehicle.axles.train_length, girder.length)
+        return StepLimits(girder.element_length, float(vehicle.natural_frequency().max()),
+                          None), irregularity
+    if isinstance(vehicle, MultibodyCars):
+        track = structure.track
+        if track is None:  # the scenario rules make this unreachable
+            raise ScenarioError("train.vehicle = 'car' needs track.model = 'slab'")
+        irregularity = build_irregularity(scenario, vehicle.length, girder.length,
+                                          (track.x_start, track.x_end))
+        return StepLimits(float(track.rails[0].length.min()), None, CONTACT_STEP), irregularity
+    return StepLimits(girder.element_length, None, None), None
+
+
+def build_coupling(scenario: Scenario, structure: Structure, vehicle: Vehicle,
+                   integrator: Integrator, irregularity: TrackIrregularity | None, *,
+                   lean: bool = False) -> Coupling:
+    """
+    Couple the scenario's vehicle model to the structure (the one place that dispatches on it).
+
+    Parameters
+    ----------
+    scenario, structure, vehicle
+        The scenario and the model built from it.
+    integrator : Integrator
+        The structure's integrator.
+    irregularity : TrackIrregularity or None
+        The realised track irregularity.
+    lean : bool
+        Lean load kernels (solver variants other than ``reference``).
+
+    """
+    if isinstance(vehicle, MultibodyCars):
+        return TrainTrackCoupling(scenario.car, scenario.contact, vehicle.n_cars,
+                                  vehicle.car_length, structure, integrator, irregularity)
+    if isinstance(vehicle, QuarterCars):
+        return QuarterCarTrain(vehicle, structure, integrator, irregularity)
+    return MovingForceCoupling(vehicle, structure, integrator, lean=lean)
 
 
 def observer_rows(scenario: Scenario, structure: Structure) -> tuple[np.ndarray, np.ndarray]:

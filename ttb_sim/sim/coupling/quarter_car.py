@@ -29,10 +29,12 @@ from __future__ import annotations
 
 import numpy as np
 
-from ttb_sim.model.bridge import GirderLine
+from ttb_sim.model.bridge import GirderLine, Structure
 from ttb_sim.model.constants import GRAVITY
+from ttb_sim.model.irregularity import TrackIrregularity
 from ttb_sim.model.vehicle.train import QuarterCars
-from ttb_sim.sim.integrators.newmark import Newmark
+from ttb_sim.sim.coupling.base import girder_wheel_load, VehicleOutputs
+from ttb_sim.sim.integrators.protocol import Integrator
 
 
 class QuarterCarCoupling:
@@ -43,7 +45,7 @@ class QuarterCarCoupling:
     from static equilibrium) lives here; the girder state is passed in.
     """
 
-    def __init__(self, cars: QuarterCars, girder: GirderLine, integrator: Newmark,
+    def __init__(self, cars: QuarterCars, girder: GirderLine, integrator: Integrator,
                  n_free: int) -> None:
         self.cars = cars
         self.girder = girder
@@ -142,3 +144,83 @@ class QuarterCarCoupling:
         self.contact = np.einsum('ik,ik->i', w, u_ext[dofs]) + b
         v_new, a_new = nm.finish(u_new, h_v, h_a)
         return u_new, v_new, a_new
+
+
+class QuarterCarTrain:
+    """
+    Quarter cars on the girders as a :class:`~ttb_sim.sim.coupling.base.Coupling`.
+
+    Owns the girder state and steps it with :class:`QuarterCarCoupling`, the
+    wheels following the centreline vertical irregularity (r, V r', V^2 r'').
+
+    Parameters
+    ----------
+    cars : QuarterCars
+        One quarter car per axle.
+    structure : Structure
+        The assembled bridge.
+    integrator : Integrator
+        The structure's integrator.
+    irregularity : TrackIrregularity or None
+        The track irregularity (None: smooth).
+
+    """
+
+    n_axles = 1
+
+    def __init__(self, cars: QuarterCars, structure: Structure, integrator: Integrator,
+                 irregularity: TrackIrregularity | None) -> None:
+        self.cars = cars
+        self.structure = structure
+        self.nm = integrator
+        self.irregularity = irregularity
+        self.kernel = QuarterCarCoupling(cars, structure.girder, integrator, structure.n_free)
+        self.n_bodies = cars.axles.count
+        n_free = structure.n_free
+        self.u = np.zeros(n_free)
+        self.v = np.zeros(n_free)
+        self.a = np.zeros(n_free)
+        self._zero = np.zeros(n_free)
+
+    def _profile(self, positions: np.ndarray) -> tuple[np.ndarray, ...] | None:
+        """Return the centreline vertical irregularity r, r', r'' under the wheels."""
+        if self.irregularity is None:
+            return None
+        s = self.irregularity.sample(positions, outside='zero')
+        return tuple(0.5 * (q[0] + q[1]) for q in (s.value, s.slope, s.curvature))
+
+    def start(self, head: float) -> None:
+        """Start at rest, the static wheel loads on the girders."""
+        st = self.structure
+        load = girder_wheel_load(st.girder, st.n_full, head - self.cars.axles.offsets,
+                                 self.cars.static_load)
+        self.a = self.nm.initial_acceleration(self.u, self.v, load[st.free])
+
+    def step(self, head: float, speed: float) -> None:
+        """Advance girders and quarter cars together by one step."""
+        positions = head - self.cars.axles.offsets
+        self.u, self.v, self.a = self.kernel.step(self.u, self.v, self.a, self._zero,
+                                                  positions, speed, self._profile(positions))
+
+    def structure_state(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Return the girder state (u, v, a) on the free DOFs."""
+        return self.u, self.v, self.a
+
+    def structure_load(self, head: float) -> np.ndarray:
+        """Return the wheel contact forces (the static loads at the start) on all DOFs."""
+        st = self.structure
+        return girder_wheel_load(st.girder, st.n_full, head - self.cars.axles.offsets,
+                                 self.kernel.contact)
+
+    def monitored(self) -> tuple[np.ndarray, ...]:
+        """Return the girder and sprung-mass displacements."""
+        return self.u, self.kernel.z
+
+    def vehicle_outputs(self) -> VehicleOutputs:
+        """Return each sprung mass's vertical acceleration and its wheel's contact force."""
+        n_b = self.n_bodies
+        acc = np.zeros((n_b, 3))
+        wheel_rail = np.zeros((n_b, 1, 2, 3))
+        acc[:, 2] = self.kernel.a
+        wheel_rail[:, 0, :, 2] = 0.5 * self.kernel.contact[:, None]
+        return VehicleOutputs(acc, np.zeros((n_b, 3)), wheel_rail)

@@ -54,17 +54,19 @@ import math
 
 import numpy as np
 
-from ttb_sim.config import Scenario
 from ttb_sim.errors import DivergenceError
 from ttb_sim.fe.beam import point_rows
 from ttb_sim.fe.factorization import factorize
 from ttb_sim.model.bridge import Structure
 from ttb_sim.model.irregularity import TrackIrregularity
 from ttb_sim.model.track import BeamLine
-from ttb_sim.model.vehicle.car import dofs as car_dofs, gyroscopic_matrix, train_matrices
+from ttb_sim.model.vehicle.car import (CarParameters, dofs as car_dofs, gyroscopic_matrix,
+                                       train_matrices)
 import ttb_sim.model.wheel_rail as ct
+from ttb_sim.model.wheel_rail.parameters import ContactParameters
 from ttb_sim.model.wheel_rail.profiles import contact_geometry_table
-from ttb_sim.sim.integrators.newmark import Newmark
+from ttb_sim.sim.coupling.base import VehicleOutputs
+from ttb_sim.sim.integrators.protocol import Integrator
 
 log = logging.getLogger(__name__)
 
@@ -104,7 +106,7 @@ class RailCompliance:
 
     Parameters
     ----------
-    integrator : Newmark
+    integrator : Integrator
         The factorised track-bridge system.
     rails : tuple of BeamLine
         Left and right rail (full DOFs).
@@ -113,7 +115,7 @@ class RailCompliance:
 
     """
 
-    def __init__(self, integrator: Newmark, rails: tuple[BeamLine, ...],
+    def __init__(self, integrator: Integrator, rails: tuple[BeamLine, ...],
                  full_to_free: np.ndarray) -> None:
         n_free = integrator.mass.shape[0]
         self.blocks = []
@@ -149,27 +151,35 @@ class TrainTrackCoupling:
 
     Parameters
     ----------
-    scenario : Scenario
-        A validated scenario with ``train.vehicle = car``.
+    car : CarParameters
+        The car record (every car of the train alike).
+    contact : ContactParameters
+        Wheel-rail contact settings.
+    n_cars, car_length
+        Cars in the train and their length over couplers (m).
     structure : Structure
         The assembled track and bridge (with ``structure.track``).
-    integrator : Newmark
+    integrator : Integrator
         The track-bridge integrator (its dt is the step).
     irregularity : TrackIrregularity or None
         The track's irregularity (None = smooth).
 
     """
 
-    def __init__(self, scenario: Scenario, structure: Structure, integrator: Newmark,
+    n_axles = 4
+
+    def __init__(self, car: CarParameters, contact: ContactParameters, n_cars: int,
+                 car_length: float, structure: Structure, integrator: Integrator,
                  irregularity: TrackIrregularity | None) -> None:
-        self.scenario = scenario
+        self.contact = contact
         self.structure = structure
         self.nm = integrator
         self.irregularity = irregularity
-        self.params = scenario.car
+        self.params = car
         p = self.params
-        tm = train_matrices(p, scenario.train.n_cars, scenario.train.car_length)
+        tm = train_matrices(p, n_cars, car_length)
         self.n_cars = tm.n_cars
+        self.n_bodies = self.n_cars
         n = self.n_cars
         self.mass = tm.mass[:42, :42].toarray()
         self.damping = tm.damping[:42, :42].toarray()
@@ -184,7 +194,7 @@ class TrainTrackCoupling:
         self.contact_x = tm.contact_x.reshape(n, 8)
         self.side = tm.contact_side.reshape(n, 8)
         self.r0 = p.wheel_radius
-        cc = scenario.contact
+        cc = contact
         self.g_hertz = float(ct.hertz_constant(p.wheel_radius, cc.tread))
         self.friction = cc.friction
         self.p0 = p.static_wheel_load
@@ -270,7 +280,7 @@ class TrainTrackCoupling:
             g = self.table.wheelset_geometry(lateral)
             h = self.table.wheel_height(lateral, self.params.contact_semi_distance)
         else:
-            g = ct.simplified_geometry(lateral, self.scenario.contact.conicity, self.r0)
+            g = ct.simplified_geometry(lateral, self.contact.conicity, self.r0)
             h = g.rolling_radius - self.r0
         left = self.side > 0
         radius = np.where(left, g.rolling_radius[..., 0], g.rolling_radius[..., 1])
@@ -560,3 +570,26 @@ class TrainTrackCoupling:
         self._rail_y = r_exact[..., 1]
         self.saturation = eps
         self.iterations = total_iter
+
+    # -- the Coupling protocol ------------------------------------------------------------
+    def start(self, head: float) -> None:
+        """Start from the static equilibrium of train and track under gravity."""
+        self.equilibrium(head)
+
+    def structure_state(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Return the track-bridge state (u, v, a) on the free DOFs."""
+        return self.u, self.v, self.a
+
+    def structure_load(self, head: float) -> np.ndarray:
+        """Return zero: the wheel loads act through the rails, not on the girder DOFs."""
+        return np.zeros(self.structure.n_full)
+
+    def monitored(self) -> tuple[np.ndarray, ...]:
+        """Return the track-bridge and car displacements."""
+        return self.u, self.q
+
+    def vehicle_outputs(self) -> VehicleOutputs:
+        """Return car-body accelerations, angular velocities and the wheel-rail forces."""
+        n = self.n_cars
+        return VehicleOutputs(self.qa[:, 0:3].copy(), self.qv[:, 3:6].copy(),
+                              self.force[..., :3].reshape(n, 4, 2, 3).copy())

@@ -12,4 +12,9 @@
 # See the License for the specific language governing permissions and
 # limitations under the License.
 
-"""integrators: see the modules of this package."""
+"""Time integrators: the protocol the couplings rely on, and Newmark's method."""
+
+from ttb_sim.sim.integrators.newmark import Newmark
+from ttb_sim.sim.integrators.protocol import Integrator
+
+__all__ = ['Integrator', 'Newmark']

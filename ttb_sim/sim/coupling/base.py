@@ -1,0 +1,95 @@
+# Copyright 2026 The ttb_sim Authors
+#
+# Licensed under the Apache License, Version 2.0 (the "License");
+# you may not use this file except in compliance with the License.
+# You may obtain a copy of the License at
+#
+#     http://www.apache.org/licenses/LICENSE-2.0
+#
+# Unless required by applicable law or agreed to in writing, software
+# distributed under the License is distributed on an "AS IS" BASIS,
+# WITHOUT WARRANTIES OR CONDITIONS OF ANY KIND, either express or implied.
+# See the License for the specific language governing permissions and
+# limitations under the License.
+
+"""
+The coupling protocol: a vehicle model and the structure it runs on, advanced together.
+
+:class:`~ttb_sim.sim.simulation.Simulation` has one stepping loop written
+against :class:`Coupling`; each vehicle model (moving forces, quarter cars,
+multibody cars on the slab track) implements it over the structure's
+:class:`~ttb_sim.sim.integrators.protocol.Integrator`. A coupling owns the
+structure state (free DOFs) and its vehicle state, and reports what a frame needs.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Protocol
+
+import numpy as np
+
+from ttb_sim.model.bridge import GirderLine
+
+__all__ = ['Coupling', 'girder_wheel_load', 'VehicleOutputs']
+
+
+@dataclass(frozen=True)
+class VehicleOutputs:
+    """The vehicle's part of a frame (SI units, track axes, z up)."""
+
+    body_acceleration: np.ndarray
+    """(n_bodies, 3) body acceleration (m/s^2)."""
+    body_angular_velocity: np.ndarray
+    """(n_bodies, 3) body angular velocity (rad/s)."""
+    wheel_rail: np.ndarray
+    """(n_bodies, n_axles, 2, 3) force of rail on wheel, left and right (N)."""
+
+
+class Coupling(Protocol):
+    """A vehicle model coupled to the structure, stepped by the simulation loop."""
+
+    n_bodies: int
+    """Bodies reported per frame (cars or quarter cars; 0 for moving forces)."""
+    n_axles: int
+    """Axles per body reported in the wheel-rail output."""
+
+    def start(self, head: float) -> None:
+        """Set the state at t = 0 with the train head at ``head`` (m)."""
+
+    def step(self, head: float, speed: float) -> None:
+        """Advance one time step; ``head`` is the head position at its end (m)."""
+
+    def structure_state(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Return the structure's (u, v, a) on the free DOFs."""
+
+    def structure_load(self, head: float) -> np.ndarray:
+        """Return the load applied to all DOFs (N), for the reactions of rigid supports."""
+
+    def monitored(self) -> tuple[np.ndarray, ...]:
+        """Return the displacements the divergence check watches: structure first, then vehicle."""
+
+    def vehicle_outputs(self) -> VehicleOutputs:
+        """Return the vehicle's part of the current frame."""
+
+
+def girder_wheel_load(girder: GirderLine, n_full: int, positions: np.ndarray,
+                      forces: np.ndarray) -> np.ndarray:
+    """
+    Return the full-DOF load of downward wheel forces on the girders.
+
+    Parameters
+    ----------
+    girder : GirderLine
+        The girder lookup.
+    n_full : int
+        Number of all DOFs.
+    positions : numpy.ndarray
+        (n,) wheel positions along the track (m).
+    forces : numpy.ndarray
+        (n,) downward force of each wheel (N).
+
+    """
+    element, (n0,) = girder.rows(positions)
+    return np.bincount(girder.w_dofs_full[element].ravel(),
+                       weights=(-forces[:, None] * n0).ravel(), minlength=n_full)
