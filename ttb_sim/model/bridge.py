@@ -38,6 +38,7 @@ import scipy.sparse as sp
 
 from ttb_sim.fe.assembly import assemble, assemble_links, link_kinematics
 from ttb_sim.fe.beam import BeamSection, global_matrices, NODE_DOFS, vertical_row, W_DOFS
+from ttb_sim.fe.dofs import DofMap
 from ttb_sim.model.track import BeamLine, build_track, TrackMesh, TrackParameters
 from ttb_sim.parameters import check_declared, param
 
@@ -264,11 +265,10 @@ class Structure:
     mass: sp.csr_matrix
     damping: sp.csr_matrix
     stiffness: sp.csr_matrix
-    n_full: int
-    free: np.ndarray
-    """Full DOF index of each free DOF."""
-    full_to_free: np.ndarray
-    """Extended free index of each full DOF."""
+    dofs: DofMap
+    """Numbering: substructure blocks 'girders', 'piers', 'track'; interfaces 'bearings'
+    (girder ends and pier tops) and 'foundations' (pier bases, where springs or piles
+    carry the piers)."""
     girder: GirderLine
     midspan_dofs: np.ndarray
     """(n_spans, 3) extended free indices of ux, uy, uz at each mid-span node."""
@@ -288,7 +288,22 @@ class Structure:
     @property
     def n_free(self) -> int:
         """Number of free DOFs."""
-        return int(self.free.size)
+        return self.dofs.n_free
+
+    @property
+    def n_full(self) -> int:
+        """Number of DOFs of all nodes."""
+        return self.dofs.n_full
+
+    @property
+    def free(self) -> np.ndarray:
+        """Full DOF index of each free DOF."""
+        return self.dofs.free
+
+    @property
+    def full_to_free(self) -> np.ndarray:
+        """Extended free index of each full DOF (constrained: ``n_free``)."""
+        return self.dofs.full_to_free
 
 
 def span_frequency(span_length: float, bending_stiffness: float, mass_per_length: float,
@@ -441,10 +456,16 @@ def assemble_structure(b: BridgeParameters, br: BearingParameters, pr: PierParam
         k_full = k_full + sp.csr_matrix((kf, (bdofs, bdofs)), shape=(n_full, n_full))
         c_full = c_full + sp.csr_matrix((cf, (bdofs, bdofs)), shape=(n_full, n_full))
 
-    free = np.flatnonzero(~constrained)
-    n_free = free.size
-    full_to_free = np.full(n_full, n_free)
-    full_to_free[free] = np.arange(n_free)
+    n_girder_nodes = girder_nodes.size
+    n_pier_nodes = int(np.count_nonzero(pier_top >= 0)) * (pr.elements + 1) if piers else 0
+    blocks = {'girders': np.arange(n_girder_nodes),
+              'piers': n_girder_nodes + np.arange(n_pier_nodes),
+              'track': np.arange(n_girder_nodes + n_pier_nodes, n_nodes)}
+    interfaces = {'bearings': np.concatenate([ends.ravel(), pier_top[pier_top >= 0]]),
+                  'foundations': pier_base[pier_base >= 0]}
+    dof_map = DofMap.compose(n_nodes, NODE_DOFS, constrained, blocks, interfaces)
+    free, full_to_free = dof_map.free, dof_map.full_to_free
+    n_free = dof_map.n_free
 
     def reduce(a: sp.csr_matrix) -> sp.csr_matrix:
         return a[free][:, free].tocsr()
@@ -472,7 +493,7 @@ def assemble_structure(b: BridgeParameters, br: BearingParameters, pr: PierParam
     mid = girder_nodes[:, ne // 2]
     midspan = full_to_free[mid[:, None] * NODE_DOFS + np.arange(3)]
     return Structure(mass=reduce(m_full), damping=reduce(c_full), stiffness=reduce(k_full),
-                     n_full=n_full, free=free, full_to_free=full_to_free, girder=girder,
+                     dofs=dof_map, girder=girder,
                      midspan_dofs=midspan, bearings=bearings, rigid=rigid,
                      n_supports=n_supports, bearing_spacing=br.spacing,
                      fundamental_frequency=f1, rayleigh=(a0, a1),

@@ -52,11 +52,10 @@ import scipy.linalg as la
 import scipy.sparse as sp
 import scipy.sparse.linalg as sla
 
-from ttb_sim.config import TrackParameters
 from ttb_sim.fe.assembly import assemble, assemble_links
 from ttb_sim.fe.beam import global_matrices, NODE_DOFS
 from ttb_sim.fe.mindlin import MindlinPlate, plate_matrices, PlateMesh, rectangular_mesh
-from ttb_sim.model.track import BeamLine, build_track, POISSON_CONCRETE, TrackMesh
+from ttb_sim.model.track import BeamLine, build_track, POISSON_CONCRETE, TrackMesh, TrackParameters
 from ttb_sim.validation.rows import Case, relative_row, Row
 
 LOG = logging.getLogger(__name__)
