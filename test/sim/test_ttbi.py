@@ -21,7 +21,7 @@ import pytest
 
 from ttb_sim.config import load_scenario
 from ttb_sim.errors import ScenarioError
-from ttb_sim.model.vehicle.car import dof
+from ttb_sim.model.vehicle.dofs import dof
 import ttb_sim.model.wheel_rail as ct
 from ttb_sim.model.wheel_rail.profiles import contact_geometry_table
 from ttb_sim.sim.simulation import Simulation

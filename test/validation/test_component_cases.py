@@ -28,7 +28,7 @@ import numpy as np
 import pytest
 
 from ttb_sim.model.irregularity.spectra import SPECTRA
-from ttb_sim.model.vehicle import car
+import ttb_sim.model.vehicle as car
 from ttb_sim.validation.cases import components as cc
 from ttb_sim.validation.rows import Row
 

@@ -27,7 +27,7 @@ import numpy as np
 import pytest
 
 from ttb_sim.errors import ModelError
-from ttb_sim.model.vehicle import car
+import ttb_sim.model.vehicle as car
 from ttb_sim.model.wheel_rail import hertz_constant, linearised_stiffness
 
 UPPER = ('car_body', 'bogie_1', 'bogie_2')

@@ -32,7 +32,9 @@ import pytest
 import scipy.linalg
 
 from ttb_sim.model.vehicle import stability as st
-from ttb_sim.model.vehicle.car import CarParameters, contact_map, N_DOF, wheelset_dofs
+from ttb_sim.model.vehicle.car import CarParameters
+from ttb_sim.model.vehicle.dofs import N_DOF, wheelset_dofs
+from ttb_sim.model.vehicle.matrices import contact_map
 import ttb_sim.model.wheel_rail as ct
 from ttb_sim.model.wheel_rail.profiles import contact_geometry_table
 

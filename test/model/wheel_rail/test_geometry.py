@@ -26,7 +26,7 @@ import numpy as np
 import pytest
 
 from ttb_sim.errors import ModelError
-from ttb_sim.model.vehicle import car
+import ttb_sim.model.vehicle as car
 from ttb_sim.model.wheel_rail import creep, geometry
 
 

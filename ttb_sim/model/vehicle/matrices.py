@@ -13,7 +13,7 @@
 # limitations under the License.
 
 """
-Build the 42-DOF multibody car of [P] (Table 1) and a train of such cars.
+The matrices of the 42-DOF multibody car of [P] (Table 1) and of a train of such cars.
 
 Bodies and degrees of freedom
 -----------------------------
@@ -60,24 +60,18 @@ Suspension layout and element counts (per car)
 * Secondary: one air spring at each of the 4 positions (2 per bogie), at
   +/-``secondary_semi_spacing`` and height ``secondary_height``, with per-spring
   stiffnesses K_sx, K_sy, K_sz.
-* Dampers (Table 1 gives only C_pz, C_sy, C_sz): by default one damper per
-  spring position, i.e. 8 primary vertical, 4 secondary vertical and
-  4 secondary lateral dampers per car, each with the Table 1 coefficient.
-  Reason: [P] builds on Zhai's equations (PHYSICS.md section 3), which write
-  the suspension force of each bogie side pair as 2 K (...) + 2 C (...)', i.e.
-  with the same multiplicity for dampers and springs; [P] gives no other count.
-  This reproduces that model literally, but it is heavily damped.  With the
-  wheelsets fixed, the damping ratios of the undamped vertical modes
-  (projection phi^T C phi / 2 omega, :func:`modal_damping_ratios`) are 0.56
-  car-body bounce, 0.63 car-body pitch, 0.65 bogie pitch and 1.52 bogie
-  bounce; PHYSICS.md's secondary-only estimate is 0.71.  The complex
-  eigenvalues of the damped system give car-body bounce |lambda| = 0.96 Hz,
-  zeta = 0.57 (damped 0.79 Hz) and over-damped bogie bounce, because the
-  dampers stiffen the primary-secondary series.  Reading the Table 1 values
-  as per-bogie totals (4 / 2 / 2 dampers) halves the projected ratios
-  (0.28, 0.32, 0.33, 0.76; damped bounce 0.82 Hz).  The counts are parameters
-  (``n_*_dampers``); dampers are smeared evenly over the spring
-  positions, so any count keeps the left/right and front/rear symmetry.
+* Dampers (Table 1 gives only C_pz, C_sy, C_sz, per damper, but not how
+  many): the counts are record fields (``primary_vertical_dampers``,
+  ``secondary_vertical_dampers``, ``secondary_lateral_dampers``), smeared
+  evenly over the spring positions so that any count keeps the left/right and
+  front/rear symmetry.  One damper per spring position (8 / 4 / 4, the literal
+  reading of Zhai's 2 K (...) + 2 C (...)' per bogie side) gives projected
+  damping ratios (phi^T C phi / 2 omega, :func:`~ttb_sim.model.vehicle.modal.
+  modal_damping_ratios`) of 0.56 car-body bounce, 0.63 car-body pitch, 0.65
+  bogie pitch and 1.52 bogie bounce, which PHYSICS.md 3.1 calls implausible;
+  the record's defaults, one primary vertical damper per wheelset and one
+  secondary vertical and lateral damper per bogie (4 / 2 / 2), halve them
+  (0.28, 0.32, 0.33, 0.76; damped bounce 0.82 Hz).
 
 Documented assumptions (not given in [P])
 -----------------------------------------
@@ -104,7 +98,6 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 import math
-from typing import Sequence
 
 import numpy as np
 import scipy.linalg
@@ -112,259 +105,9 @@ import scipy.sparse
 
 from ttb_sim.errors import ModelError
 from ttb_sim.model.constants import GRAVITY
-from ttb_sim.parameters import check_declared, param
-
-#: Names of the seven bodies, in DOF order.
-BODY_NAMES = ('car_body', 'bogie_1', 'bogie_2',
-              'wheelset_1', 'wheelset_2', 'wheelset_3', 'wheelset_4')
-
-#: Names of the six components of each body, in DOF order.
-COMPONENTS = ('x', 'y', 'z', 'roll', 'pitch', 'yaw')
-
-N_BODIES = 7
-DOF_PER_BODY = 6
-N_DOF = N_BODIES * DOF_PER_BODY
-
-CAR_BODY = 0
-BOGIES = (1, 2)
-WHEELSETS = (3, 4, 5, 6)
-
-#: Sides of the wheels, in contact order: left (+1, y > 0) then right (-1).
-SIDES = (1, -1)
-
-
-def _index(names: Sequence[str], key: int | str, what: str) -> int:
-    if isinstance(key, str):
-        if key not in names:
-            msg = f'{what} {key!r} is unknown; allowed: {", ".join(names)}'
-            raise ModelError(msg)
-        return names.index(key)
-    value = int(key)
-    if not 0 <= value < len(names):
-        msg = f'{what} index {key} is out of range; allowed: 0..{len(names) - 1}'
-        raise ModelError(msg)
-    return value
-
-
-def dof(body: int | str, component: int | str) -> int:
-    """
-    Return the index of one DOF in the 42-vector of a car.
-
-    Parameters
-    ----------
-    body : int or str
-        Body index 0..6 or name from :data:`BODY_NAMES`.
-    component : int or str
-        Component index 0..5 or name from :data:`COMPONENTS`.
-
-    Returns
-    -------
-    int
-        ``6 * body + component``.
-
-    Raises
-    ------
-    ModelError
-        If the body or component is unknown.
-
-    """
-    return (DOF_PER_BODY * _index(BODY_NAMES, body, 'body')
-            + _index(COMPONENTS, component, 'component'))
-
-
-def dofs(bodies: Sequence[int | str], components: Sequence[int | str]) -> np.ndarray:
-    """
-    Return the DOF indices of every (body, component) pair, body-major.
-
-    Parameters
-    ----------
-    bodies : sequence of int or str
-        Bodies (indices or names).
-    components : sequence of int or str
-        Components (indices or names).
-
-    Returns
-    -------
-    numpy.ndarray
-        Integer array of ``len(bodies) * len(components)`` indices.
-
-    """
-    return np.array([dof(b, c) for b in bodies for c in components], dtype=int)
-
-
-def wheelset_dofs(j: int) -> np.ndarray:
-    """
-    Return the six DOF indices of wheelset ``j`` (0..3, front to rear).
-
-    Parameters
-    ----------
-    j : int
-        Wheelset number within the car, 0 = leading axle.
-
-    Returns
-    -------
-    numpy.ndarray
-        Indices of x, y, z, roll, pitch (spin perturbation), yaw.
-
-    """
-    if not 0 <= int(j) < 4:
-        raise ModelError(f'wheelset number {j} is out of range; allowed: 0..3')
-    return dofs([WHEELSETS[int(j)]], COMPONENTS)
-
-
-@dataclass(frozen=True)
-class CarParameters:
-    """
-    One car ([P] Table 1 plus documented assumptions); the scenario's ``car`` section.
-
-    Units are SI: masses kg, inertias kg m^2, stiffness per spring N/m (8 axle
-    boxes and 4 air springs per car), damping per damper N s/m (the ``*_dampers``
-    counts say how many act per car, smeared evenly over the spring positions),
-    lengths m.  Every field is declared with :func:`~ttb_sim.parameters.param`,
-    so it is settable from a scenario file as ``car.<field>``.
-    """
-
-    car_body_mass: float = param(48000.0, 'kg', 'Car body mass M_c.', low=1.0, high=1e6)
-    bogie_mass: float = param(3200.0, 'kg', 'Bogie frame mass M_t.', low=1.0, high=1e5)
-    wheelset_mass: float = param(2400.0, 'kg', 'Wheelset mass M_w.', low=1.0, high=1e5)
-    car_body_pitch_inertia: float = param(2.3e6, 'kg*m^2', 'Car body pitch inertia I_cy.',
-                                          low=1.0, high=1e9)
-    car_body_roll_inertia: float = param(1.15e5, 'kg*m^2', 'Car body roll inertia I_cx.',
-                                         low=1.0, high=1e9)
-    car_body_yaw_inertia: float = param(2.3e6, 'kg*m^2', 'Car body yaw inertia I_cz.',
-                                        low=1.0, high=1e9)
-    bogie_pitch_inertia: float = param(7200.0, 'kg*m^2', 'Bogie pitch inertia I_ty.', low=1.0,
-                                       high=1e7)
-    bogie_roll_inertia: float = param(3200.0, 'kg*m^2', 'Bogie roll inertia I_tx.', low=1.0,
-                                      high=1e7)
-    bogie_yaw_inertia: float = param(6800.0, 'kg*m^2', 'Bogie yaw inertia I_tz.', low=1.0,
-                                     high=1e7)
-    wheelset_roll_inertia: float = param(1200.0, 'kg*m^2', 'Wheelset roll inertia I_wx.',
-                                         low=1.0, high=1e6)
-    wheelset_spin_inertia: float = param(200.0, 'kg*m^2', 'Wheelset inertia about its axle '
-                                         'I_wy (spin perturbation and gyroscopic terms).',
-                                         low=1.0, high=1e6)
-    wheelset_yaw_inertia: float = param(1200.0, 'kg*m^2', 'Wheelset yaw inertia I_wz.',
-                                        low=1.0, high=1e6)
-    primary_stiffness_x: float = param(9.0e6, 'N/m', 'Primary longitudinal stiffness per '
-                                       'axle box.', low=1.0, high=1e13)
-    primary_stiffness_y: float = param(3.0e6, 'N/m', 'Primary lateral stiffness per axle box.',
-                                       low=1.0, high=1e13)
-    primary_stiffness_z: float = param(1.04e6, 'N/m', 'Primary vertical stiffness per axle '
-                                       'box.', low=1.0, high=1e13)
-    secondary_stiffness_x: float = param(0.24e6, 'N/m', 'Secondary longitudinal stiffness per '
-                                         'air spring.', low=1.0, high=1e13)
-    secondary_stiffness_y: float = param(0.24e6, 'N/m', 'Secondary lateral stiffness per air '
-                                         'spring.', low=1.0, high=1e13)
-    secondary_stiffness_z: float = param(0.4e6, 'N/m', 'Secondary vertical stiffness per air '
-                                         'spring.', low=1.0, high=1e13)
-    primary_damping_z: float = param(45.0e3, 'N*s/m', 'Primary vertical damping per damper.',
-                                     low=0.0, high=1e9)
-    secondary_damping_y: float = param(3.0e3, 'N*s/m', 'Secondary lateral damping per damper.',
-                                       low=0.0, high=1e9)
-    secondary_damping_z: float = param(98.0e3, 'N*s/m', 'Secondary vertical damping per '
-                                       'damper.', low=0.0, high=1e9)
-    primary_vertical_dampers: int = param(4, '-', 'Primary vertical dampers per car (one per '
-                                          'wheelset: Zhai-type bogies carry one damper per '
-                                          'side of each bogie; see README).', low=0, high=64)
-    secondary_vertical_dampers: int = param(2, '-', 'Secondary vertical dampers per car (one '
-                                            'per bogie).', low=0, high=64)
-    secondary_lateral_dampers: int = param(2, '-', 'Secondary lateral dampers per car (one '
-                                           'per bogie).', low=0, high=64)
-    yaw_damping: float = param(250.0e3, 'N*s/m', 'Anti-yaw (longitudinal) damper between '
-                               'bogie and car body, per damper; assumed, not in [P] Table 1 '
-                               '(see README).', low=0.0, high=1e9)
-    yaw_dampers: int = param(4, '-', 'Anti-yaw dampers per car (one on each side of each bogie; '
-                             '0 = the literal Table 1 car).', low=0, high=64)
-    yaw_damper_semi_spacing: float = param(1.35, 'm', 'Lateral semi-spacing of the anti-yaw '
-                                           'dampers (assumed).', low=0.1, high=2.0)
-    bogie_semi_spacing: float = param(7.85, 'm', 'Half the distance between bogie centres '
-                                      '(l_c, [P] Table 1); also sets the axle layout of '
-                                      'moving forces and quarter cars.', low=0.1, high=30.0)
-    wheelbase_semi: float = param(1.25, 'm', 'Half the bogie wheelbase (l_t, [P] Table 1).',
-                                  low=0.1, high=5.0)
-    wheel_radius: float = param(0.46, 'm', 'Nominal rolling radius r0.', low=0.1, high=2.0)
-    contact_semi_distance: float = param(0.7465, 'm', 'Half the lateral distance between '
-                                         'the contact points b.', low=0.3, high=1.5)
-    primary_semi_spacing: float = param(1.0, 'm', 'Lateral semi-spacing of the axle-box '
-                                        'springs (assumed).', low=0.1, high=3.0)
-    secondary_semi_spacing: float = param(1.0, 'm', 'Lateral semi-spacing of the air springs '
-                                          '(assumed).', low=0.1, high=3.0)
-    car_body_cg_height: float = param(1.70, 'm', 'Car body centre of gravity above the rail '
-                                      'top (assumed).', low=0.1, high=5.0)
-    secondary_height: float = param(0.90, 'm', 'Height of the air springs above the rail top '
-                                    '(assumed).', low=0.1, high=5.0)
-    bogie_cg_height: float = param(0.46, 'm', 'Bogie centre of gravity above the rail top '
-                                   '(assumed).', low=0.1, high=5.0)
-    longitudinal_pitch_coupling: bool = param(False, '-', 'False: longitudinal suspension '
-                                              'forces have no pitch moment arm (Zhai-type '
-                                              'model); true: they act at the physical '
-                                              'heights.')
-
-    def __post_init__(self) -> None:
-        """Check every field against its declaration, then the geometric rules."""
-        check_declared(self, 'car parameter')
-        if self.wheelbase_semi >= self.bogie_semi_spacing:
-            msg = (f'car parameter wheelbase_semi = {self.wheelbase_semi!r} is invalid; '
-                   f'allowed: < bogie_semi_spacing ({self.bogie_semi_spacing})')
-            raise ModelError(msg)
-        if self.wheel_radius >= self.wheelbase_semi:
-            msg = (f'car parameter wheel_radius = {self.wheel_radius!r} is invalid; '
-                   f'allowed: < wheelbase_semi ({self.wheelbase_semi})')
-            raise ModelError(msg)
-
-    @property
-    def static_wheel_load(self) -> float:
-        """Static wheel load P0 = (Mc/8 + Mt/4 + Mw/2) g (N)."""
-        return static_wheel_load(self)
-
-    @property
-    def total_mass(self) -> float:
-        """Total mass of the car, Mc + 2 Mt + 4 Mw (kg)."""
-        return self.car_body_mass + 2.0 * self.bogie_mass + 4.0 * self.wheelset_mass
-
-
-def static_wheel_load(params: CarParameters | None = None) -> float:
-    """
-    Return the static wheel load P0 = (Mc/8 + Mt/4 + Mw/2) g.
-
-    Parameters
-    ----------
-    params : CarParameters, optional
-        Car parameters; Table 1 defaults if omitted.
-
-    Returns
-    -------
-    float
-        P0 in N (78.48 kN for Table 1).
-
-    """
-    p = params or CarParameters()
-    return (p.car_body_mass / 8.0 + p.bogie_mass / 4.0 + p.wheelset_mass / 2.0) * GRAVITY
-
-
-def body_positions(params: CarParameters | None = None) -> np.ndarray:
-    """
-    Return the centre of gravity of each body in the car frame.
-
-    Parameters
-    ----------
-    params : CarParameters, optional
-        Car parameters; Table 1 defaults if omitted.
-
-    Returns
-    -------
-    numpy.ndarray
-        Shape (7, 3): x (m, forward from the car centre), y (0) and z (m, height
-        above the rail top) of each body, in DOF order.
-
-    """
-    p = params or CarParameters()
-    lc, lt = p.bogie_semi_spacing, p.wheelbase_semi
-    x = np.array([0.0, lc, -lc, lc + lt, lc - lt, -lc + lt, -lc - lt])
-    z = np.array([p.car_body_cg_height, p.bogie_cg_height, p.bogie_cg_height]
-                 + [p.wheel_radius] * 4)
-    return np.column_stack([x, np.zeros(N_BODIES), z])
+from ttb_sim.model.vehicle.car import body_positions, CarParameters
+from ttb_sim.model.vehicle.dofs import (BOGIES, CAR_BODY, dof, DOF_PER_BODY, dofs, N_BODIES, N_DOF,
+                                        SIDES, WHEELSETS)
 
 
 def mass_matrix(params: CarParameters | None = None) -> np.ndarray:
@@ -781,74 +524,6 @@ def car_matrices(params: CarParameters | None = None) -> CarMatrices:
     p = params or CarParameters()
     return CarMatrices(mass_matrix(p), damping_matrix(p), stiffness_matrix(p),
                        gravity_vector(p), contact_map(p), p)
-
-
-def eigenfrequencies(
-        mass: np.ndarray, stiffness: np.ndarray,
-        subset: Sequence[int] | np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
-    """
-    Return undamped eigenfrequencies and modes of a DOF subset.
-
-    DOFs outside ``subset`` are held fixed (e.g. pass the vertical DOFs of the
-    car body and bogies to get the modes with the wheelsets fixed).
-
-    Parameters
-    ----------
-    mass, stiffness : numpy.ndarray
-        Full square matrices.
-    subset : sequence of int, optional
-        DOF indices kept free; all DOFs if omitted.
-
-    Returns
-    -------
-    frequencies : numpy.ndarray
-        Ascending frequencies (Hz); tiny negative eigenvalues are clipped to 0.
-    modes : numpy.ndarray
-        Shape (n_dof, n_subset): mass-normalised mode shapes expanded to the
-        full DOF vector (zeros on held DOFs), column i for frequency i.
-
-    """
-    n = mass.shape[0]
-    idx = np.arange(n) if subset is None else np.asarray(subset, dtype=int)
-    k = stiffness[np.ix_(idx, idx)]
-    m = mass[np.ix_(idx, idx)]
-    lam, vec = scipy.linalg.eigh(0.5 * (k + k.T), 0.5 * (m + m.T))
-    freq = np.sqrt(np.clip(lam, 0.0, None)) / (2.0 * math.pi)
-    modes = np.zeros((n, idx.size))
-    modes[idx] = vec
-    return freq, modes
-
-
-def modal_damping_ratios(
-        mass: np.ndarray, damping: np.ndarray, stiffness: np.ndarray,
-        subset: Sequence[int] | np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
-    """
-    Return damping ratios of the undamped modes, zeta_i = phi_i^T C phi_i / (2 omega_i).
-
-    This projection neglects the coupling of modes by non-proportional
-    damping; it is the usual way to quote a suspension's damping ratio.
-
-    Parameters
-    ----------
-    mass, damping, stiffness : numpy.ndarray
-        Full square matrices.
-    subset : sequence of int, optional
-        DOF indices kept free (others held fixed).
-
-    Returns
-    -------
-    frequencies : numpy.ndarray
-        Undamped frequencies (Hz), ascending.
-    ratios : numpy.ndarray
-        Damping ratio per mode (-); NaN for zero-frequency modes.
-
-    """
-    freq, modes = eigenfrequencies(mass, stiffness, subset)
-    omega = 2.0 * math.pi * freq
-    proj = np.einsum('ij,ik,kj->j', modes, damping, modes)
-    with np.errstate(divide='ignore', invalid='ignore'):
-        ratios = np.where(omega > 0.0, proj / (2.0 * omega), np.nan)
-    return freq, ratios
 
 
 @dataclass(frozen=True)

@@ -101,9 +101,10 @@ import scipy.linalg
 from scipy.optimize import brentq
 
 from ttb_sim.errors import ScenarioError
-from ttb_sim.model.vehicle.car import (CarParameters, contact_map, damping_matrix, DOF_PER_BODY,
-                                       dofs as car_dofs, gyroscopic_matrix, mass_matrix, N_BODIES,
-                                       N_DOF, stiffness_matrix, WHEELSETS)
+from ttb_sim.model.vehicle.car import CarParameters
+from ttb_sim.model.vehicle.dofs import DOF_PER_BODY, dofs as car_dofs, N_BODIES, N_DOF, WHEELSETS
+from ttb_sim.model.vehicle.matrices import (contact_map, damping_matrix, gyroscopic_matrix,
+                                            mass_matrix, stiffness_matrix)
 import ttb_sim.model.wheel_rail as ct
 from ttb_sim.model.wheel_rail.profiles import contact_geometry_table, ContactGeometryTable
 

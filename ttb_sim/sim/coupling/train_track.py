@@ -60,8 +60,9 @@ from ttb_sim.fe.factorization import factorize
 from ttb_sim.model.bridge import Structure
 from ttb_sim.model.irregularity import TrackIrregularity
 from ttb_sim.model.track import BeamLine
-from ttb_sim.model.vehicle.car import (CarParameters, dofs as car_dofs, gyroscopic_matrix,
-                                       train_matrices)
+from ttb_sim.model.vehicle.car import CarParameters
+from ttb_sim.model.vehicle.dofs import dofs as car_dofs
+from ttb_sim.model.vehicle.matrices import gyroscopic_matrix, train_matrices
 import ttb_sim.model.wheel_rail as ct
 from ttb_sim.model.wheel_rail.parameters import ContactParameters
 from ttb_sim.model.wheel_rail.profiles import contact_geometry_table

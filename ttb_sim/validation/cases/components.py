@@ -45,7 +45,7 @@ import numpy as np
 from scipy import signal
 
 from ttb_sim.model.irregularity import check_variance, SPECTRA, synthesize, VarianceCheck
-from ttb_sim.model.vehicle import car
+import ttb_sim.model.vehicle as car
 from ttb_sim.model.wheel_rail import hertz_constant, linearised_stiffness, static_compression
 from ttb_sim.validation.rows import Case, relative_row, Row
 
