@@ -33,7 +33,6 @@ from ttb_sim.model.irregularity.spectra import (band_rms, band_variance, COMPONE
                                                 SpectrumComponent, SpectrumFamily)
 from ttb_sim.model.irregularity.synthesis import (available_spectra, IrregularityLayer,
                                                   MIN_RECORD_WAVELENGTHS, PRESETS, synthesize)
-from ttb_sim.model.irregularity.variance import check_variance, VarianceCheck
 
 __all__ = [
     'COMPONENTS',
@@ -50,11 +49,9 @@ __all__ = [
     'SpectrumComponent',
     'SpectrumFamily',
     'TrackIrregularity',
-    'VarianceCheck',
     'available_spectra',
     'band_rms',
     'band_variance',
-    'check_variance',
     'get_spectrum',
     'load_csv',
     'sato_spectrum',

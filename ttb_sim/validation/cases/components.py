@@ -44,9 +44,10 @@ import math
 import numpy as np
 from scipy import signal
 
-from ttb_sim.model.irregularity import check_variance, SPECTRA, synthesize, VarianceCheck
+from ttb_sim.model.irregularity import SPECTRA, synthesize
 import ttb_sim.model.vehicle as car
 from ttb_sim.model.wheel_rail import hertz_constant, linearised_stiffness, static_compression
+from ttb_sim.validation.references.irregularity import check_variance, VarianceCheck
 from ttb_sim.validation.rows import Case, relative_row, Row
 
 #: Car body and bogies: the bodies left free in V4 (wheelsets held).
@@ -192,7 +193,7 @@ def _label(family: str, component: str, n_components: int) -> str:
 
 def variance_checks(seeds: int = ENSEMBLE_SEEDS) -> dict[str, list[VarianceCheck]]:
     """
-    Run :func:`ttb_sim.model.irregularity.variance.check_variance` on every component.
+    Run :func:`ttb_sim.validation.references.irregularity.check_variance` on every component.
 
     Parameters
     ----------

@@ -15,7 +15,8 @@
 """
 Validation quantities of the synthesis (VALIDATION.md V8, V10).
 
-The variance of a spectrum component synthesised by :mod:`.synthesis`,
+The variance of a spectrum component synthesised by
+:mod:`ttb_sim.model.irregularity.synthesis`,
 averaged over seeds, against the integral of its PSD over the band.
 """
 

@@ -26,7 +26,8 @@ from __future__ import annotations
 import pytest
 from scipy import integrate
 
-from ttb_sim.model.irregularity import spectra, variance
+from ttb_sim.model.irregularity import spectra
+from ttb_sim.validation.references import irregularity as variance
 
 ALL_COMPONENTS = [(f, c) for f, fam in spectra.SPECTRA.items() for c in fam.components]
 
