@@ -18,6 +18,7 @@ import numpy as np
 import pytest
 import scipy.sparse as sp
 from ttb_sim.config import key_spec, load_scenario, Scenario
+from ttb_sim.sim.coupling.base import girder_wheel_load
 from ttb_sim.sim.integrators.newmark import Newmark
 from ttb_sim.sim.lean import MovingLoad
 from ttb_sim.sim.simulation import Simulation
@@ -85,7 +86,7 @@ def test_lean_moving_load_equals_the_general_assembly():
     lean = MovingLoad(st.girder, sim.vehicle.loads, st.n_free, st.n_full)
     for head in (0.0, 17.3, 160.0, 321.9, 500.0):
         positions = head - sim.vehicle.axles.offsets
-        full = sim._moving_load(positions)
+        full = girder_wheel_load(st.girder, st.n_full, positions, sim.vehicle.loads)
         scale = np.max(np.abs(full)) or 1.0
         assert np.max(np.abs(lean.full(positions) - full)) <= 1e-14 * scale
         assert np.max(np.abs(lean(positions) - full[st.free])) <= 1e-14 * scale
