@@ -251,8 +251,8 @@ def test_default_yaw_dampers_stable_at_300_and_350_kmh(
 def test_critical_speed_refuses_a_bracket_that_starts_unstable(
         table_geometry: st.LinearGeometry) -> None:
     """A scan starting above the critical speed is refused, stable ranges give inf."""
-    from ttb_sim.errors import ScenarioError
+    from ttb_sim.errors import ModelError
     p = CarParameters(yaw_dampers=0)
-    with pytest.raises(ScenarioError, match='unstable already'):
+    with pytest.raises(ModelError, match='unstable already'):
         st.critical_speed(p, table_geometry, speed_range=(300.0 * KMH, 400.0 * KMH))
     assert st.critical_speed(p, table_geometry, speed_range=(20.0, 60.0), n_scan=3) == math.inf

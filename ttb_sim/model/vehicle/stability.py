@@ -100,7 +100,7 @@ import numpy as np
 import scipy.linalg
 from scipy.optimize import brentq
 
-from ttb_sim.errors import ScenarioError
+from ttb_sim.errors import ModelError
 from ttb_sim.model.vehicle.car import CarParameters
 from ttb_sim.model.vehicle.dofs import DOF_PER_BODY, dofs as car_dofs, N_BODIES, N_DOF, WHEELSETS
 from ttb_sim.model.vehicle.matrices import (contact_map, damping_matrix, gyroscopic_matrix,
@@ -203,7 +203,7 @@ def conicity_geometry(conicity: float, nominal_radius: float = 0.46, *,
     g = ct.simplified_geometry(0.0, conicity, nominal_radius)
     angle = float(g.contact_angle[0]) if contact_angle is None else float(contact_angle)
     if not (math.isfinite(angle) and abs(angle) < 0.5 * math.pi):
-        raise ScenarioError(f'contact_angle = {contact_angle!r} rad is invalid; '
+        raise ModelError(f'contact_angle = {contact_angle!r} rad is invalid; '
                             'allowed: |angle| < pi/2')
     side = np.array([1.0, -1.0])
     return LinearGeometry(radius=np.asarray(g.rolling_radius, dtype=float),
@@ -239,7 +239,7 @@ def table_geometry(table: ContactGeometryTable | None = None, semi_distance: flo
 
     """
     if not (math.isfinite(step) and step > 0.0):
-        raise ScenarioError(f'geometry step = {step!r} m is invalid; allowed: finite and > 0')
+        raise ModelError(f'geometry step = {step!r} m is invalid; allowed: finite and > 0')
     tb = table if table is not None else contact_geometry_table()
     y = np.array([-step, 0.0, step])
     g = tb.wheelset_geometry(y)
@@ -303,9 +303,9 @@ def contact_matrices(params: CarParameters | None, speed: float, geometry: Linea
     """
     p = params or CarParameters()
     if not (math.isfinite(speed) and speed > 0.0):
-        raise ScenarioError(f'speed = {speed!r} m/s is invalid; allowed: finite and > 0')
+        raise ModelError(f'speed = {speed!r} m/s is invalid; allowed: finite and > 0')
     if not (math.isfinite(creep_factor) and creep_factor > 0.0):
-        raise ScenarioError(f'creep_factor = {creep_factor!r} is invalid; allowed: > 0')
+        raise ModelError(f'creep_factor = {creep_factor!r} is invalid; allowed: > 0')
     cm = contact_map(p)
     r0 = p.wheel_radius
     p0 = p.static_wheel_load
@@ -558,7 +558,7 @@ def least_damped_mode(params: CarParameters | None, speed: float, geometry: Line
 
     Raises
     ------
-    ScenarioError
+    ModelError
         If no mode qualifies.
 
     """
@@ -566,7 +566,7 @@ def least_damped_mode(params: CarParameters | None, speed: float, geometry: Line
                   if (md.lateral_fraction > 0.5 or not lateral)
                   and (md.frequency > 0.0 or not oscillatory)]
     if not candidates:
-        raise ScenarioError('no mode matches the selection (lateral / oscillatory)')
+        raise ModelError('no mode matches the selection (lateral / oscillatory)')
     return candidates[0]
 
 
@@ -629,15 +629,15 @@ def critical_speed(params: CarParameters | None, geometry: LinearGeometry, *,
 
     Raises
     ------
-    ScenarioError
+    ModelError
         On invalid arguments, or if the car is already unstable at the lowest speed.
 
     """
     low, high = (float(v) for v in speed_range)
     if not (math.isfinite(low) and math.isfinite(high) and 0.0 < low < high):
-        raise ScenarioError(f'speed_range = {speed_range!r} is invalid; allowed: 0 < low < high')
+        raise ModelError(f'speed_range = {speed_range!r} is invalid; allowed: 0 < low < high')
     if int(n_scan) < 2 or not (math.isfinite(tol) and tol > 0.0):
-        raise ScenarioError(f'n_scan = {n_scan!r} / tol = {tol!r} are invalid; '
+        raise ModelError(f'n_scan = {n_scan!r} / tol = {tol!r} are invalid; '
                             'allowed: n_scan >= 2, tol > 0')
 
     def growth(v: float) -> float:
@@ -646,7 +646,7 @@ def critical_speed(params: CarParameters | None, geometry: LinearGeometry, *,
     speeds = np.linspace(low, high, int(n_scan))
     previous = growth(speeds[0])
     if previous > 0.0:
-        raise ScenarioError(f'the car is unstable already at {low:.3g} m/s '
+        raise ModelError(f'the car is unstable already at {low:.3g} m/s '
                             f'(max Re(lambda) = {previous:.3g} 1/s); lower speed_range')
     for v0, v1 in zip(speeds[:-1], speeds[1:]):
         current = growth(v1)
