@@ -204,7 +204,7 @@ def conicity_geometry(conicity: float, nominal_radius: float = 0.46, *,
     angle = float(g.contact_angle[0]) if contact_angle is None else float(contact_angle)
     if not (math.isfinite(angle) and abs(angle) < 0.5 * math.pi):
         raise ModelError(f'contact_angle = {contact_angle!r} rad is invalid; '
-                            'allowed: |angle| < pi/2')
+                         'allowed: |angle| < pi/2')
     side = np.array([1.0, -1.0])
     return LinearGeometry(radius=np.asarray(g.rolling_radius, dtype=float),
                           radius_slope=side * conicity, angle=np.full(2, angle),
@@ -638,7 +638,7 @@ def critical_speed(params: CarParameters | None, geometry: LinearGeometry, *,
         raise ModelError(f'speed_range = {speed_range!r} is invalid; allowed: 0 < low < high')
     if int(n_scan) < 2 or not (math.isfinite(tol) and tol > 0.0):
         raise ModelError(f'n_scan = {n_scan!r} / tol = {tol!r} are invalid; '
-                            'allowed: n_scan >= 2, tol > 0')
+                         'allowed: n_scan >= 2, tol > 0')
 
     def growth(v: float) -> float:
         return max_real_part(params, v, geometry, **kwargs)
@@ -647,7 +647,7 @@ def critical_speed(params: CarParameters | None, geometry: LinearGeometry, *,
     previous = growth(speeds[0])
     if previous > 0.0:
         raise ModelError(f'the car is unstable already at {low:.3g} m/s '
-                            f'(max Re(lambda) = {previous:.3g} 1/s); lower speed_range')
+                         f'(max Re(lambda) = {previous:.3g} 1/s); lower speed_range')
     for v0, v1 in zip(speeds[:-1], speeds[1:]):
         current = growth(v1)
         if current > 0.0:
