@@ -182,12 +182,14 @@ class QuarterCarTrain:
         self.a = np.zeros(n_free)
         self._zero = np.zeros(n_free)
 
-    def _profile(self, positions: np.ndarray) -> tuple[np.ndarray, ...] | None:
+    def _profile(self, positions: np.ndarray
+                 ) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
         """Return the centreline vertical irregularity r, r', r'' under the wheels."""
         if self.irregularity is None:
             return None
         s = self.irregularity.sample(positions, outside='zero')
-        return tuple(0.5 * (q[0] + q[1]) for q in (s.value, s.slope, s.curvature))
+        return (0.5 * (s.value[0] + s.value[1]), 0.5 * (s.slope[0] + s.slope[1]),
+                0.5 * (s.curvature[0] + s.curvature[1]))
 
     def start(self, head: float) -> None:
         """Start at rest, the static wheel loads on the girders."""

@@ -54,7 +54,7 @@ import math
 
 import numpy as np
 
-from ttb_sim.errors import DivergenceError
+from ttb_sim.errors import DivergenceError, ModelError
 from ttb_sim.fe.beam import point_rows
 from ttb_sim.fe.factorization import factorize
 from ttb_sim.model.bridge import Structure
@@ -65,7 +65,7 @@ from ttb_sim.model.vehicle.dofs import dofs as car_dofs
 from ttb_sim.model.vehicle.matrices import gyroscopic_matrix, train_matrices
 import ttb_sim.model.wheel_rail as ct
 from ttb_sim.model.wheel_rail.parameters import ContactParameters
-from ttb_sim.model.wheel_rail.profiles import contact_geometry_table
+from ttb_sim.model.wheel_rail.profiles import contact_geometry_table, ContactGeometryTable
 from ttb_sim.sim.coupling.base import VehicleOutputs
 from ttb_sim.sim.integrators.protocol import Integrator
 
@@ -201,11 +201,11 @@ class TrainTrackCoupling:
         self.p0 = p.static_wheel_load
         ellipse = ct.hertz_ellipse(self.p0, p.wheel_radius)
         self.creep0 = ct.creep_coefficients(ellipse.a, ellipse.b)
-        if cc.geometry == 'profiles':
-            self.table = contact_geometry_table()
-        else:
-            self.table = None
+        self.table: ContactGeometryTable | None = (
+            contact_geometry_table() if cc.geometry == 'profiles' else None)
         track = structure.track
+        if track is None:
+            raise ModelError('multibody cars need the slab track: the structure has none')
         self.rails = track.rails
         self.head_arm = np.array([0.0, 0.0, track.rail_head])
         ftf = structure.full_to_free

@@ -31,6 +31,7 @@ from __future__ import annotations
 from typing import Protocol
 
 import numpy as np
+import scipy.sparse as sp
 
 __all__ = ['Integrator']
 
@@ -44,6 +45,14 @@ class Integrator(Protocol):
     """Coefficient of u_{n+1} in the end-of-step acceleration (1/s^2)."""
     a1: float
     """Coefficient of u_{n+1} in the end-of-step velocity (1/s)."""
+    mass: sp.csr_matrix
+    """Mass matrix of the integrated system (free DOFs)."""
+    damping: sp.csr_matrix
+    """Damping matrix."""
+    stiffness: sp.csr_matrix
+    """Stiffness matrix."""
+    method: str
+    """Sparse factorisation in use (:func:`ttb_sim.fe.factorization.factorize`)."""
 
     def history(self, u: np.ndarray, v: np.ndarray,
                 a: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
