@@ -32,7 +32,8 @@ TINY = ['moving_force_beam']
 def _check_run(run: dict) -> None:
     for key in ('scenario', 'variant', 'factorization', 'status', 'dofs', 'dt', 'steps',
                 'frames', 'simulated_time', 'build_time', 'start_time', 'step_time',
-                'ms_per_step', 'real_time_factor', 'peak_rss_mib', 'difference'):
+                'ms_per_step', 'cpu_ms_per_step', 'real_time_factor', 'peak_rss_mib',
+                'difference'):
         assert key in run, key
     assert set(run['dofs']) == {'structure', 'track', 'bridge', 'vehicle', 'total'}
     assert set(run['difference']) == set(bn.QUANTITIES)

@@ -18,9 +18,10 @@ import numpy as np
 import pytest
 import scipy.sparse as sp
 from ttb_sim.config import key_spec, load_scenario, Scenario
+from ttb_sim.fe.beam import point_rows
 from ttb_sim.sim.coupling.base import girder_wheel_load
 from ttb_sim.sim.integrators.newmark import Newmark
-from ttb_sim.sim.lean import MovingLoad
+from ttb_sim.sim.lean import MovingLoad, point_rows_and_slopes
 from ttb_sim.sim.simulation import Simulation
 from ttb_sim.sim.variants import blas_threads, solver_variant, VARIANTS
 
@@ -90,3 +91,12 @@ def test_lean_moving_load_equals_the_general_assembly():
         scale = np.max(np.abs(full)) or 1.0
         assert np.max(np.abs(lean.full(positions) - full)) <= 1e-14 * scale
         assert np.max(np.abs(lean(positions) - full[st.free])) <= 1e-14 * scale
+
+
+def test_rail_rows_and_slopes_are_point_rows_bit_for_bit():
+    rng = np.random.default_rng(11)
+    xi, length = rng.random(64), 0.3 + 0.4 * rng.random(64)
+    arm = np.array([0.0, 0.0, 0.176])
+    rows, slopes = point_rows_and_slopes(xi, length, arm)
+    assert np.array_equal(rows, point_rows(xi, length, arm))
+    assert np.array_equal(slopes, point_rows(xi, length, arm, 1))

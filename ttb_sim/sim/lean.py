@@ -25,7 +25,52 @@ from __future__ import annotations
 
 import numpy as np
 
+from ttb_sim.fe.beam import hermite, offset_rows, V_DOFS, W_DOFS
 from ttb_sim.model.bridge import GirderLine
+
+_W_SIGN = np.array([1.0, -1.0, 1.0, -1.0])
+"""Signs that turn Hermite functions into the (uz, ry) row (ry = -w')."""
+
+
+def point_rows_and_slopes(xi: np.ndarray, length: np.ndarray,
+                          arm: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """
+    Return ``point_rows(xi, length, arm)`` and its x-derivative, bit for bit.
+
+    :func:`ttb_sim.fe.beam.point_rows` evaluates the Hermite functions four
+    times per call, eight for the pair; here each derivative order (0, 1, 2)
+    is evaluated once and shared (the same elementwise operations, so the same
+    numbers). The rail-head rows under every wheel need the pair at each step.
+
+    Parameters
+    ----------
+    xi, length : numpy.ndarray
+        Local coordinate and element length, shape (n,).
+    arm : numpy.ndarray
+        Offset of the points from the beam axis, (3,) (m).
+
+    Returns
+    -------
+    (rows, slopes)
+        Each (n, 3, 12).
+
+    """
+    xi = np.asarray(xi, dtype=float)
+    length = np.broadcast_to(np.asarray(length, dtype=float), xi.shape)
+    h = [hermite(xi, length, d) for d in range(3)]
+    fields = np.zeros((2,) + xi.shape + (6, 12))
+    linear = (np.stack([1.0 - xi, xi], axis=-1),
+              np.stack([-1.0 / length, 1.0 / length], axis=-1))
+    for k in range(2):
+        out = fields[k]
+        out[..., 0, [0, 6]] = linear[k]
+        out[..., 3, [3, 9]] = linear[k]
+        out[..., 1, V_DOFS] = h[k]
+        out[..., 2, W_DOFS] = h[k] * _W_SIGN
+        out[..., 4, W_DOFS] = -(h[k + 1] * _W_SIGN)
+        out[..., 5, V_DOFS] = h[k + 1]
+    rows = offset_rows(fields, arm)
+    return rows[0], rows[1]
 
 
 class MovingLoad:

@@ -55,7 +55,6 @@ import math
 import numpy as np
 
 from ttb_sim.errors import DivergenceError, ModelError
-from ttb_sim.fe.beam import point_rows
 from ttb_sim.fe.factorization import factorize
 from ttb_sim.model.bridge import Structure
 from ttb_sim.model.irregularity import TrackIrregularity
@@ -68,6 +67,7 @@ from ttb_sim.model.wheel_rail.parameters import ContactParameters
 from ttb_sim.model.wheel_rail.profiles import contact_geometry_table, ContactGeometryTable
 from ttb_sim.sim.coupling.base import VehicleOutputs
 from ttb_sim.sim.integrators.protocol import Integrator
+from ttb_sim.sim.lean import point_rows_and_slopes
 
 log = logging.getLogger(__name__)
 
@@ -249,11 +249,9 @@ class TrainTrackCoupling:
             length[sel] = rail.length[element]
             dofs[sel] = self.rail_dofs[r][element]
             blocks[sel] = self.compliance.blocks[r][element]
-        # Rows of both rails in one evaluation (elementwise, so the same numbers).
-        rows = point_rows(xi.ravel(), length.ravel(), self.head_arm).reshape(shape + (3, 12))
-        slope = point_rows(xi.ravel(), length.ravel(), self.head_arm, 1).reshape(
-            shape + (3, 12))
-        return rows, slope, dofs, blocks
+        # Rows and slopes of both rails in one evaluation (elementwise, so the same numbers).
+        rows, slope = point_rows_and_slopes(xi.ravel(), length.ravel(), self.head_arm)
+        return rows.reshape(shape + (3, 12)), slope.reshape(shape + (3, 12)), dofs, blocks
 
     def _irregularity(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Return vertical and lateral rail irregularity and lateral slope under each wheel."""
