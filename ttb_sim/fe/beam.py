@@ -32,6 +32,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 NODE_DOFS = 6
 ELEMENT_DOFS = 12
@@ -64,7 +65,7 @@ class BeamSection:
     inertia_x: np.ndarray
 
 
-def hermite(xi: np.ndarray, length: np.ndarray, derivative: int = 0) -> np.ndarray:
+def hermite(xi: ArrayLike, length: ArrayLike, derivative: int = 0) -> np.ndarray:
     """
     Evaluate cubic Hermite functions, or their x-derivatives, at local coordinates.
 
@@ -101,7 +102,7 @@ def hermite(xi: np.ndarray, length: np.ndarray, derivative: int = 0) -> np.ndarr
                      h[3] * length * scale], axis=-1)
 
 
-def vertical_row(xi: np.ndarray, length: np.ndarray, derivative: int = 0) -> np.ndarray:
+def vertical_row(xi: ArrayLike, length: ArrayLike, derivative: int = 0) -> np.ndarray:
     """
     Map the local element DOFs (uz1, ry1, uz2, ry2) to w or its x-derivatives.
 
@@ -115,7 +116,7 @@ def vertical_row(xi: np.ndarray, length: np.ndarray, derivative: int = 0) -> np.
     return h * np.array([1.0, -1.0, 1.0, -1.0])
 
 
-def lateral_row(xi: np.ndarray, length: np.ndarray, derivative: int = 0) -> np.ndarray:
+def lateral_row(xi: ArrayLike, length: ArrayLike, derivative: int = 0) -> np.ndarray:
     """Map the local element DOFs (uy1, rz1, uy2, rz2) to v or its x-derivatives."""
     return hermite(xi, length, derivative)
 

@@ -26,7 +26,8 @@ the same call works for both back-ends.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any, Callable
+from functools import partial
+from typing import Any, Callable, Sequence
 
 import numpy as np
 
@@ -53,7 +54,7 @@ def _header(types: MessageTypes, stamp_ns: int) -> Any:
     return types('std_msgs/msg/Header')(stamp=_time(types, stamp_ns), frame_id=FRAME_ID)
 
 
-def _vector3(types: MessageTypes, xyz: np.ndarray) -> Any:
+def _vector3(types: MessageTypes, xyz: Sequence[float] | np.ndarray) -> Any:
     return types('geometry_msgs/msg/Vector3')(x=float(xyz[0]), y=float(xyz[1]),
                                               z=float(xyz[2]))
 
@@ -154,6 +155,35 @@ class Topic:
         return self.build(types, frame.stamp_ns, self.extract(frame))
 
 
+# Frame -> values of each topic family (the index arguments are bound per topic).
+def _no_values(frame: Frame) -> np.ndarray:
+    return np.zeros(0)
+
+
+def _odometry_values(frame: Frame) -> np.ndarray:
+    return np.array([frame.head_position, frame.speed])
+
+
+def _body_imu_values(body: int, frame: Frame) -> np.ndarray:
+    return np.concatenate([frame.body_acceleration[body], frame.body_angular_velocity[body]])
+
+
+def _wheel_rail_values(body: int, axle: int, side: int, frame: Frame) -> np.ndarray:
+    return np.concatenate([frame.wheel_rail[body, axle, side], np.zeros(3)])
+
+
+def _midspan_values(span: int, frame: Frame) -> np.ndarray:
+    return frame.midspan[span]
+
+
+def _bearing_values(support: int, side: int, frame: Frame) -> np.ndarray:
+    return np.concatenate([frame.bearings[support, side], np.zeros(3)])
+
+
+def _observer_values(observer: int, frame: Frame) -> np.ndarray:
+    return frame.observers[observer]
+
+
 def topic_table(layout: Layout) -> list[Topic]:
     """
     Return the topics a run with this layout produces, in a fixed order.
@@ -169,39 +199,34 @@ def topic_table(layout: Layout) -> list[Topic]:
 
     """
     topics = [
-        Topic('/clock', 'rosgraph_msgs/msg/Clock', (), lambda f: np.zeros(0), build_clock,
+        Topic('/clock', 'rosgraph_msgs/msg/Clock', (), _no_values, build_clock,
               qos='clock', unit='s'),
         Topic('train/odometry', 'nav_msgs/msg/Odometry',
               ('pose.pose.position.x', 'twist.twist.linear.x'),
-              lambda f: np.array([f.head_position, f.speed]), build_odometry, unit='m, m/s'),
+              _odometry_values, build_odometry, unit='m, m/s'),
     ]
     for i in range(layout.n_bodies):
         topics.append(Topic(
             f'train/car{i + 1:02d}/body/imu', 'sensor_msgs/msg/Imu', IMU,
-            lambda f, i=i: np.concatenate([f.body_acceleration[i],
-                                           f.body_angular_velocity[i]]),
-            build_imu, unit='m/s^2, rad/s'))
+            partial(_body_imu_values, i), build_imu, unit='m/s^2, rad/s'))
         for k in range(layout.n_axles):
             for s, side in enumerate(('left', 'right')):
                 topics.append(Topic(
                     f'wheel_rail/car{i + 1:02d}/axle{k + 1}/{side}',
                     'geometry_msgs/msg/WrenchStamped', WRENCH,
-                    lambda f, i=i, k=k, s=s: np.concatenate([f.wheel_rail[i, k, s],
-                                                             np.zeros(3)]),
-                    build_wrench_stamped, unit='N'))
+                    partial(_wheel_rail_values, i, k, s), build_wrench_stamped, unit='N'))
     for k in range(layout.n_spans):
         topics.append(Topic(f'bridge/span{k + 1:02d}/midspan',
                             'geometry_msgs/msg/Vector3Stamped', VECTOR3,
-                            lambda f, k=k: f.midspan[k], build_vector3_stamped, unit='m'))
+                            partial(_midspan_values, k), build_vector3_stamped, unit='m'))
     for s in range(layout.n_supports):
         for side_index, side in enumerate(('left', 'right')):
             topics.append(Topic(
                 f'bearings/pier{s + 1:02d}/{side}', 'geometry_msgs/msg/WrenchStamped', WRENCH,
-                lambda f, s=s, j=side_index: np.concatenate([f.bearings[s, j], np.zeros(3)]),
-                build_wrench_stamped, unit='N'))
+                partial(_bearing_values, s, side_index), build_wrench_stamped, unit='N'))
     for j, name in enumerate(layout.observers):
         topics.append(Topic(f'observers/{name}', 'geometry_msgs/msg/Vector3Stamped', VECTOR3,
-                            lambda f, j=j: f.observers[j], build_vector3_stamped, unit='m'))
+                            partial(_observer_values, j), build_vector3_stamped, unit='m'))
     return topics
 
 

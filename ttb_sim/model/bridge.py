@@ -280,7 +280,7 @@ class Structure:
     """First vertical bending frequency of a simply supported span (Hz)."""
     rayleigh: tuple[float, float]
     """Rayleigh coefficients (a0, a1) of C = a0 M + a1 K for the beams."""
-    girder_beam: BeamLine | None = None
+    girder_beam: BeamLine
     """The girders as a beam line (full DOFs), for point lookups of all six fields."""
     track: TrackMesh | None = None
     """The slab track (full DOF numbering), if modelled."""
@@ -536,6 +536,7 @@ def bearing_forces(structure: Structure, u: np.ndarray, v: np.ndarray, a: np.nda
         np.add.at(out, (bg.support, bg.side), force)
         return out
     rg = structure.rigid
+    assert rg is not None, 'a structure has either elastic bearings or rigid supports'
     reaction = rg.rows_k @ u + rg.rows_c @ v + rg.rows_m @ a - load_full[rg.full_dofs]
     on_support = -reaction
     e2 = structure.bearing_spacing

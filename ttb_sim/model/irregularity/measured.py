@@ -178,7 +178,7 @@ def load_csv(
     try:
         numbers = cells.astype(np.float64)
     except ValueError:
-        parsed = np.frompyfunc(_parses_as_float, 1, 1)(cells).astype(bool)
+        parsed = np.asarray(np.frompyfunc(_parses_as_float, 1, 1)(cells)).astype(bool)
         r, c = np.argwhere(~parsed)[0]
         message = f'non-numeric value {str(cells[r, c])!r} in column {CSV_COLUMNS[c]}'
         raise _refuse(path, int(row_numbers[r]), message) from None

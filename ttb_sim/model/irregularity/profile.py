@@ -185,7 +185,7 @@ class TrackIrregularity:
     @property
     def x(self) -> NDArray[np.float64]:
         """Return the grid positions (m)."""
-        return self.x_start + self.dx * np.arange(self.n_points)
+        return self.x_start + self.dx * np.arange(self.n_points, dtype=np.float64)
 
     @property
     def z_left(self) -> NDArray[np.float64]:

@@ -295,4 +295,6 @@ def synthesize(
         arrays.append(arr)
     _LOG.debug('synthesised %s: %d points (FFT %d), dx %g m, seed %d, scale %g',
                label, n_req, n_fft, dx, seed, scale)
-    return TrackIrregularity(x_start, dx, *arrays, source=f'{label} seed={seed} scale={scale:g}')
+    values, slopes, curvatures = arrays
+    return TrackIrregularity(x_start, dx, values, slopes, curvatures,
+                             source=f'{label} seed={seed} scale={scale:g}')

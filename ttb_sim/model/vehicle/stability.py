@@ -94,7 +94,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 import logging
 import math
-from typing import Sequence
+from typing import Sequence, TYPE_CHECKING, TypedDict
 
 import numpy as np
 import scipy.linalg
@@ -108,12 +108,16 @@ from ttb_sim.model.vehicle.matrices import (contact_map, damping_matrix, gyrosco
 import ttb_sim.model.wheel_rail as ct
 from ttb_sim.model.wheel_rail.profiles import contact_geometry_table, ContactGeometryTable
 
+if TYPE_CHECKING:
+    from typing_extensions import Unpack
+
 log = logging.getLogger(__name__)
 
 __all__ = [
     'GEOMETRY_STEP',
     'LATERAL_DOFS',
     'LinearCar',
+    'LinearCarOptions',
     'LinearGeometry',
     'Mode',
     'NULL_TOLERANCE',
@@ -366,6 +370,15 @@ class LinearCar:
     speed: float
 
 
+class LinearCarOptions(TypedDict, total=False):
+    """The keyword options of :func:`linear_car`, passed on by the speed-scan helpers."""
+
+    tread: str
+    creep_factor: float
+    suspension: bool
+    dofs: Sequence[int] | np.ndarray | None
+
+
 def linear_car(params: CarParameters | None, speed: float, geometry: LinearGeometry, *,
                tread: str = 'lm', creep_factor: float = 1.0, suspension: bool = True,
                dofs: Sequence[int] | np.ndarray | None = None) -> LinearCar:
@@ -531,8 +544,8 @@ def modes(system: LinearCar) -> list[Mode]:
 
 
 def least_damped_mode(params: CarParameters | None, speed: float, geometry: LinearGeometry, *,
-                      lateral: bool = True, oscillatory: bool = True, **kwargs: object
-                      ) -> Mode:
+                      lateral: bool = True, oscillatory: bool = True,
+                      **kwargs: Unpack[LinearCarOptions]) -> Mode:
     """
     Return the least-damped (lateral, oscillatory) mode at speed V.
 
@@ -571,7 +584,7 @@ def least_damped_mode(params: CarParameters | None, speed: float, geometry: Line
 
 
 def max_real_part(params: CarParameters | None, speed: float, geometry: LinearGeometry,
-                  **kwargs: object) -> float:
+                  **kwargs: Unpack[LinearCarOptions]) -> float:
     """
     Return the largest real part of the non-rigid eigenvalues at speed V (1/s).
 
@@ -598,7 +611,7 @@ def max_real_part(params: CarParameters | None, speed: float, geometry: LinearGe
 
 def critical_speed(params: CarParameters | None, geometry: LinearGeometry, *,
                    speed_range: tuple[float, float] = (5.0, 200.0), n_scan: int = 40,
-                   tol: float = 0.01, **kwargs: object) -> float:
+                   tol: float = 0.01, **kwargs: Unpack[LinearCarOptions]) -> float:
     """
     Return the lowest speed at which an eigenvalue crosses into Re(lambda) > 0.
 

@@ -276,7 +276,7 @@ def octave_ratios(family: str, component: str, seed: int = WELCH_SEED,
     return (band @ psd) / (band @ target)
 
 
-def octave_row(family: str, ratios: Mapping[str, Sequence[float]]) -> Row:
+def octave_row(family: str, ratios: Mapping[str, Sequence[float] | np.ndarray]) -> Row:
     """
     Build the V9 row of one family: the band ratio farthest from 1.
 

@@ -267,11 +267,12 @@ def plate_mesh(component: str = 'slab', track: TrackParameters | None = None,
 def _eig(k: np.ndarray | sp.spmatrix, m: np.ndarray | sp.spmatrix,
          f_max: float, n_guess: int = 40) -> tuple[np.ndarray, np.ndarray]:
     """Return eigenfrequencies (Hz) up to f_max (rigid modes removed) and mode shapes."""
-    if sp.issparse(k):
-        sigma = -(2 * math.pi * RIGID_LIMIT) ** 2
-        w2, v = sla.eigsh(k.tocsc(), min(n_guess, k.shape[0] - 2), m.tocsc(), sigma=sigma)
-    else:
+    if isinstance(k, np.ndarray) and isinstance(m, np.ndarray):
         w2, v = la.eigh(k, m)
+    else:
+        sigma = -(2 * math.pi * RIGID_LIMIT) ** 2
+        w2, v = sla.eigsh(sp.csc_matrix(k), min(n_guess, k.shape[0] - 2), sp.csc_matrix(m),
+                          sigma=sigma)
     order = np.argsort(w2)
     f = np.sqrt(np.abs(w2[order])) / (2 * math.pi)
     keep = (f > RIGID_LIMIT) & (f <= f_max)

@@ -316,6 +316,8 @@ def fe_critical_speed(values: Sequence[tuple[str, Any]] = (),
     """
     scenario = base_scenario(values, overrides)
     st = Simulation(scenario).structure
+    if st.track is None:
+        raise ValueError("the V2 critical speed needs the slab track (track.model = 'slab')")
     rail = st.track.rails[0]
     n_e = scenario.track.rail_elements_per_bay
     s = scenario.track.fastener_spacing
@@ -394,13 +396,15 @@ def contact_frf(irregularity: np.ndarray, force: np.ndarray, rate: float,
 
     """
     n = int(round(segment_seconds * rate))
-    sxy = sxx = syy = 0.0
+    sxy: np.ndarray | float = 0.0
+    sxx: np.ndarray | float = 0.0
+    syy: np.ndarray | float = 0.0
     for r, f in zip(irregularity.T, force.T):
         freq, pxy = signal.csd(r, f, fs=rate, window='hann', nperseg=n)
         _, pxx = signal.welch(r, fs=rate, window='hann', nperseg=n)
         _, pyy = signal.welch(f, fs=rate, window='hann', nperseg=n)
         sxy, sxx, syy = sxy + pxy, sxx + pxx, syy + pyy
-    h1 = sxy / sxx
+    h1 = np.asarray(sxy / sxx)
     coherence = np.abs(sxy)**2 / (sxx * syy)
     peak = peak_frequency(freq, np.abs(h1)**2, band=band)
     return FrfEstimate(freq, h1, coherence, peak)
@@ -444,6 +448,8 @@ def v6_run(record: float, segment_seconds: float, values: Sequence[tuple[str, An
     if head0 - offsets[-1] < track_start(scenario) or head0 + travel - offsets[0] > 0.0:
         raise ValueError('the V6 run must keep the car on the approach (rigid ground)')
     sim = Simulation(scenario)
+    if sim.irregularity is None:
+        raise ValueError('the V6 run needs a rail irregularity (a spectrum or file, scale > 0)')
     heads, forces, times = [], [], []
     for frame in sim.frames():
         heads.append(frame.head_position)

@@ -25,6 +25,7 @@ from dataclasses import dataclass
 import math
 
 import numpy as np
+from numpy.typing import ArrayLike
 from scipy.integrate import solve_ivp
 from scipy.optimize import minimize_scalar
 
@@ -40,7 +41,7 @@ class Beam:
     mass: float
     damping_ratio: float = 0.0
 
-    def omega(self, j: np.ndarray) -> np.ndarray:
+    def omega(self, j: ArrayLike) -> np.ndarray:
         """Return the circular frequencies of modes j (rad/s)."""
         return (np.asarray(j) * math.pi / self.length) ** 2 * math.sqrt(self.ei / self.mass)
 
