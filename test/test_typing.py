@@ -15,10 +15,10 @@
 """
 mypy on the whole package with the setup.cfg configuration (issue 9, item 7).
 
-The package is checked as one; errors are only tolerated in the files of
-:data:`ALLOWED`, which are being restructured concurrently. The list only
-shrinks: the test also fails when an allow-listed file has become clean, so
-that its entry is removed in the same change.
+The package is checked as one and must be clean. :data:`ALLOWED` may name a file
+whose errors are tolerated for a while (with the reason); it is empty today. The
+list only shrinks: the test also fails when an allow-listed file has become
+clean, so that its entry is removed in the same change.
 """
 
 from collections import defaultdict
@@ -29,14 +29,7 @@ import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
 
-ALLOWED = {
-    'ttb_sim/sim/simulation.py':
-        'Optional track / train-track coupling used unchecked; the one-loop Simulation of '
-        'issue 9 item 3 is being written concurrently.',
-    'ttb_sim/sim/coupling/train_track.py':
-        'Optional track mesh and contact table; the coupling folder of issue 9 item 3 is '
-        'being written concurrently.',
-}
+ALLOWED: dict[str, str] = {}
 """Files (relative to the repository root) whose mypy errors are tolerated for now, and why."""
 
 _ERROR = re.compile(r'^(?P<path>[^:\s][^:]*):\d+(?::\d+)?: error: ')
