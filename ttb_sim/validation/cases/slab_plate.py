@@ -271,8 +271,11 @@ def _eig(k: np.ndarray | sp.spmatrix, m: np.ndarray | sp.spmatrix,
         w2, v = la.eigh(k, m)
     else:
         sigma = -(2 * math.pi * RIGID_LIMIT) ** 2
+        # A fixed start vector: ARPACK's default one is random, and the modes must
+        # come out the same, bit for bit, on every run.
+        start = np.ones(k.shape[0])
         w2, v = sla.eigsh(sp.csc_matrix(k), min(n_guess, k.shape[0] - 2), sp.csc_matrix(m),
-                          sigma=sigma)
+                          sigma=sigma, v0=start)
     order = np.argsort(w2)
     f = np.sqrt(np.abs(w2[order])) / (2 * math.pi)
     keep = (f > RIGID_LIMIT) & (f <= f_max)
