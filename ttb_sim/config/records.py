@@ -29,6 +29,7 @@ from __future__ import annotations
 
 import dataclasses
 from dataclasses import dataclass, field
+import functools
 import math
 import re
 from typing import Any, Sequence
@@ -143,6 +144,11 @@ class OutputConfig:
                                        'rail_right, slab, base or girder and x the position '
                                        'along the track (m); published on ~/observers/name.')
 
+    @functools.cached_property
+    def points(self) -> tuple[Observer, ...]:
+        """The observers parsed once (see :func:`parse_observers`)."""
+        return parse_observers(self.observers)
+
 
 @dataclass(frozen=True)
 class Scenario:
@@ -194,7 +200,7 @@ def _check_consistency(s: Scenario) -> None:
     if s.track.model == 'slab' and s.train.vehicle != 'car':
         raise ScenarioError(f"track.model = 'slab' needs train.vehicle = 'car' (got "
                             f'{s.train.vehicle!r})')
-    parse_observers(s.output.observers)
+    s.output.points  # parse (and so check) the observers once
 
 
 OBSERVER_COMPONENTS = ('rail_left', 'rail_right', 'slab', 'base', 'girder')

@@ -26,7 +26,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from ttb_sim.config import parse_observers, Scenario
+from ttb_sim.config import Scenario
 from ttb_sim.errors import ScenarioError
 from ttb_sim.model.bridge import assemble_structure, Structure
 from ttb_sim.model.irregularity import load_csv, synthesize, TrackIrregularity
@@ -151,7 +151,7 @@ def observer_rows(scenario: Scenario, structure: Structure) -> tuple[np.ndarray,
         component.
 
     """
-    observers = parse_observers(scenario.output.observers)
+    observers = scenario.output.points
     dofs = np.zeros((len(observers), 12), dtype=int)
     rows = np.zeros((len(observers), 3, 12))
     ftf = structure.full_to_free

@@ -27,7 +27,7 @@ from typing import Iterator
 
 import numpy as np
 
-from ttb_sim.config import parse_observers, Scenario
+from ttb_sim.config import Scenario
 from ttb_sim.errors import DivergenceError, ModelError
 from ttb_sim.model.bridge import bearing_forces
 from ttb_sim.sim.build import (build_coupling, build_structure, build_vehicle, observer_rows,
@@ -112,7 +112,7 @@ class Simulation:
         self.duration = scenario.solver.duration or self.auto_duration()
         self.n_steps = max(1, math.ceil(self.duration / dt - 1e-9))
         self.observers = observer_rows(scenario, st)
-        names = tuple(o.name for o in parse_observers(scenario.output.observers))
+        names = tuple(o.name for o in scenario.output.points)
         self.variant = solver_variant(scenario.solver.variant)
         with blas_threads(self.variant.blas_threads):
             self.integrator = Newmark(st.mass, st.damping, st.stiffness, dt,
