@@ -17,7 +17,8 @@
 from pathlib import Path
 
 import pytest
-from ttb_sim.config import builtin_scenarios, iter_keys, key_spec, load_scenario, Scenario
+from ttb_sim.config import (builtin_scenarios, from_mapping, iter_keys, key_spec, load_scenario,
+                            Scenario)
 from ttb_sim.errors import ScenarioError
 
 CONTRACT_KEYS = ('bridge.span_length', 'bridge.bending_stiffness', 'bridge.mass_per_length',
@@ -102,11 +103,17 @@ def test_axle_layout_from_car_geometry():
     assert axles[4] - axles[0] == pytest.approx(25.0)
 
 
-def test_moved_car_geometry_keys_point_to_their_new_home():
-    """train.bogie_semi_spacing moved to the car record: refused, naming the new key."""
-    with pytest.raises(ScenarioError, match="moved to 'car.bogie_semi_spacing'"):
-        load_scenario('moving_force_beam', ['train.bogie_semi_spacing=7.0'])
-    s = load_scenario('moving_force_beam', ['car.wheelbase_semi=1.5', 'train.axle_offsets=[]',
+def test_old_car_geometry_keys_still_set_the_car_record():
+    """train.bogie_semi_spacing / wheelbase_semi are aliases of the car record's keys."""
+    s = load_scenario('moving_force_beam', ['train.bogie_semi_spacing=7.0',
+                                            'train.wheelbase_semi=1.5', 'train.axle_offsets=[]',
                                             'train.n_cars=1'])
+    assert (s.car.bogie_semi_spacing, s.car.wheelbase_semi) == (7.0, 1.5)
     axles = s.axle_positions()
     assert axles[1] - axles[0] == pytest.approx(3.0)
+    assert axles[2] - axles[0] == pytest.approx(14.0)
+    with pytest.raises(ScenarioError, match='old name of car.wheelbase_semi'):
+        from_mapping({'train': {'wheelbase_semi': 1.5}, 'car': {'wheelbase_semi': 1.2}})
+    last = load_scenario('moving_force_beam', ['train.wheelbase_semi=1.5',
+                                               'car.wheelbase_semi=1.2'])
+    assert last.car.wheelbase_semi == 1.2  # --set values apply in order

@@ -23,7 +23,7 @@ import sysconfig
 from typing import Any, Sequence
 
 from ttb_sim.config.records import Scenario
-from ttb_sim.config.schema import from_mapping, key_spec
+from ttb_sim.config.schema import canonical_key, from_mapping, key_spec
 from ttb_sim.errors import ScenarioError
 import yaml
 
@@ -146,6 +146,7 @@ def apply_overrides(data: dict[str, Any], overrides: Sequence[tuple[str, Any]]) 
     """
     for key, value in overrides:
         key_spec(key)  # raises on unknown keys
+        key = canonical_key(key)
         node = data
         parts = key.split('.')
         for part in parts[:-1]:

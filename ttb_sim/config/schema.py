@@ -31,24 +31,50 @@ from typing import Any, Iterator, Mapping
 from ttb_sim.errors import ModelError, ScenarioError
 from ttb_sim.parameters import Spec
 
-__all__ = ['from_mapping', 'iter_keys', 'key_spec', 'MOVED_KEYS', 'to_plain']
+__all__ = ['ALIASES', 'canonical_key', 'from_mapping', 'iter_keys', 'key_spec',
+           'resolve_aliases', 'to_plain']
 
-MOVED_KEYS = {
+ALIASES = {
     'train.bogie_semi_spacing': 'car.bogie_semi_spacing',
     'train.wheelbase_semi': 'car.wheelbase_semi',
 }
-"""Keys that moved to another section (old path -> new path), refused with a pointer."""
+"""Old key paths that still work, and the key each now sets (the car record owns the
+car geometry since the records were unified; scenario files and ``--set`` using the old
+paths keep working)."""
 
 
-def _moved(path: str) -> str:
-    """Return a hint for a key that moved, or an empty string."""
-    new = MOVED_KEYS.get(path)
-    return f' (it moved to {new!r}: the car record holds the car geometry)' if new else ''
+def canonical_key(path: str) -> str:
+    """Return the key path an alias stands for (the path itself when it is no alias)."""
+    return ALIASES.get(path, path)
 
 
-# --------------------------------------------------------------------------------------
-# Key walking
-# --------------------------------------------------------------------------------------
+def resolve_aliases(data: Mapping[str, Any]) -> dict[str, Any]:
+    """
+    Return a copy of plain scenario data with aliased keys moved to their new place.
+
+    Raises
+    ------
+    ScenarioError
+        If an alias and its key are both given with different values.
+
+    """
+    out = {k: dict(v) if isinstance(v, Mapping) else v for k, v in data.items()}
+    for old, new in ALIASES.items():
+        old_section, old_key = old.split('.')
+        section = out.get(old_section)
+        if not isinstance(section, dict) or old_key not in section:
+            continue
+        value = section.pop(old_key)
+        new_section, new_key = new.split('.')
+        target = out.setdefault(new_section, {})
+        if not isinstance(target, dict):
+            continue  # from_mapping reports the malformed section
+        if new_key in target and target[new_key] != value:
+            raise ScenarioError(f'{old} = {value!r} and {new} = {target[new_key]!r} set the '
+                                f'same key ({old} is the old name of {new}); give one')
+        target[new_key] = value
+    return out
+
 
 def iter_keys(cls: type | None = None, prefix: str = '') -> Iterator[tuple[str, type, Any, Spec]]:
     """
@@ -80,11 +106,11 @@ def key_spec(path: str) -> tuple[type, Any, Spec]:
         If the key does not exist.
 
     """
+    path = canonical_key(path)
     for key, typ, default, spec in iter_keys():
         if key == path:
             return typ, default, spec
-    raise ScenarioError(f'unknown key {path!r}{_moved(path)}; see `ttb-sim scenarios --keys` '
-                        'for the list')
+    raise ScenarioError(f'unknown key {path!r}; see `ttb-sim scenarios --keys` for the list')
 
 
 def _root(cls: type | None) -> type:
@@ -119,6 +145,8 @@ def from_mapping(data: Mapping[str, Any], cls: type | None = None, prefix: str =
         names the key path, the value and what is allowed.
 
     """
+    if cls is None and isinstance(data, Mapping):
+        data = resolve_aliases(data)
     cls = _root(cls)
     if not isinstance(data, Mapping):
         where = prefix[:-1] or 'the scenario'
@@ -130,7 +158,7 @@ def from_mapping(data: Mapping[str, Any], cls: type | None = None, prefix: str =
         path = f'{prefix}{key}'
         if key not in names:
             allowed = ', '.join(sorted(names))
-            raise ScenarioError(f'unknown key {path!r}{_moved(path)}; allowed here: {allowed}')
+            raise ScenarioError(f'unknown key {path!r}; allowed here: {allowed}')
         f = names[key]
         if 'spec' in f.metadata:
             kwargs[key] = _coerce(path, value, hints[key], f.metadata['spec'])
