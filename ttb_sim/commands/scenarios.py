@@ -17,6 +17,7 @@
 from __future__ import annotations
 
 from ttb_sim.config import builtin_scenarios, iter_keys, read_yaml
+from ttb_sim.config.schema import ALIASES
 
 EXIT_OK = 0
 
@@ -28,6 +29,8 @@ def scenarios(*, keys: bool = False) -> int:
             dyn = ' (dynamic)' if spec.dynamic else ''
             print(f'{key:34s} {spec.unit:9s} default {default!r:14} {spec.allowed()}{dyn}\n'
                   f'{"":34s} {spec.description}')
+        for old, new in ALIASES.items():
+            print(f'{old:34s} alias of {new}')
         return EXIT_OK
     for name, path in builtin_scenarios().items():
         try:
