@@ -25,6 +25,7 @@ the same call works for both back-ends.
 
 from __future__ import annotations
 
+import array
 from dataclasses import dataclass
 from functools import partial
 from typing import Any, Callable, Sequence
@@ -100,6 +101,32 @@ def build_odometry(types: MessageTypes, stamp_ns: int, values: np.ndarray) -> An
     return types('nav_msgs/msg/Odometry')(header=_header(types, stamp_ns),
                                           child_frame_id='train', pose=pose_cov,
                                           twist=twist_cov)
+
+
+SOIL_FIELDS = ('x', 'y', 'z', 'ux', 'uy', 'uz', 'ax', 'ay', 'az')
+"""Float32 fields of every ground point in ``~/soil/points``, in this order."""
+_FLOAT32 = 7  # sensor_msgs/msg/PointField.FLOAT32
+
+
+def build_point_cloud(types: MessageTypes, stamp_ns: int, values: np.ndarray) -> Any:
+    """
+    Build ``sensor_msgs/msg/PointCloud2`` of ground points from flattened (n, 9) values.
+
+    One row of n points (``height`` 1), little-endian float32 fields
+    :data:`SOIL_FIELDS`, 36 bytes per point, dense.
+    """
+    points = np.ascontiguousarray(np.asarray(values, dtype='<f4').reshape(-1, len(SOIL_FIELDS)))
+    field_type = types('sensor_msgs/msg/PointField')
+    fields = [field_type(name=name, offset=4 * i, datatype=_FLOAT32, count=1)
+              for i, name in enumerate(SOIL_FIELDS)]
+    step = 4 * len(SOIL_FIELDS)
+    cloud = types('sensor_msgs/msg/PointCloud2')
+    raw = points.view(np.uint8).ravel()
+    # rosbags' message classes take a numpy uint8 array, rclpy's an array('B').
+    data: Any = raw if cloud.__module__.startswith('rosbags') else array.array('B', raw.tobytes())
+    return cloud(header=_header(types, stamp_ns), height=1, width=int(points.shape[0]),
+                 fields=fields, is_bigendian=False, point_step=step,
+                 row_step=step * int(points.shape[0]), data=data, is_dense=True)
 
 
 def build_clock(types: MessageTypes, stamp_ns: int, values: np.ndarray) -> Any:
@@ -184,6 +211,18 @@ def _observer_values(observer: int, frame: Frame) -> np.ndarray:
     return frame.observers[observer]
 
 
+def _pile_displacement_values(pile: int, frame: Frame) -> np.ndarray:
+    return frame.pile_displacement[pile]
+
+
+def _pile_imu_values(pile: int, frame: Frame) -> np.ndarray:
+    return np.concatenate([frame.pile_acceleration[pile], frame.pile_rotation_rate[pile]])
+
+
+def _soil_values(frame: Frame) -> np.ndarray:
+    return frame.soil_points.ravel()
+
+
 def topic_table(layout: Layout) -> list[Topic]:
     """
     Return the topics a run with this layout produces, in a fixed order.
@@ -224,6 +263,20 @@ def topic_table(layout: Layout) -> list[Topic]:
             topics.append(Topic(
                 f'bearings/pier{s + 1:02d}/{side}', 'geometry_msgs/msg/WrenchStamped', WRENCH,
                 partial(_bearing_values, s, side_index), build_wrench_stamped, unit='N'))
+    index = 0
+    for pier, n_piles in layout.piles:
+        for m in range(n_piles):
+            base = f'piles/pier{pier:02d}/pile{m + 1:02d}'
+            topics.append(Topic(f'{base}/displacement', 'geometry_msgs/msg/Vector3Stamped',
+                                VECTOR3, partial(_pile_displacement_values, index),
+                                build_vector3_stamped, unit='m'))
+            topics.append(Topic(f'{base}/imu', 'sensor_msgs/msg/Imu', IMU,
+                                partial(_pile_imu_values, index), build_imu,
+                                unit='m/s^2, rad/s'))
+            index += 1
+    if layout.soil_points:
+        topics.append(Topic('soil/points', 'sensor_msgs/msg/PointCloud2', (), _soil_values,
+                            build_point_cloud, unit='m, m, m/s^2'))
     for j, name in enumerate(layout.observers):
         topics.append(Topic(f'observers/{name}', 'geometry_msgs/msg/Vector3Stamped', VECTOR3,
                             partial(_observer_values, j), build_vector3_stamped, unit='m'))

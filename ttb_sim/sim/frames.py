@@ -16,7 +16,7 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -33,6 +33,15 @@ class Layout:
     """Axles per body with wheel-rail forces (4 for multibody cars)."""
     observers: tuple[str, ...] = ()
     """Names of the displacement observers."""
+    piles: tuple[tuple[int, int], ...] = ()
+    """(pier number, 1-based; number of piles) of every piled pier, in frame order."""
+    soil_points: int = 0
+    """Number of ground observation points (all piled piers together)."""
+
+    @property
+    def n_piles(self) -> int:
+        """Total number of piles over all piled piers."""
+        return sum(n for _, n in self.piles)
 
 
 @dataclass(frozen=True)
@@ -52,6 +61,12 @@ class Frame:
     body_angular_velocity : (n_bodies, 3) car-body angular velocity (rad/s)
     wheel_rail : (n_bodies, n_axles, 2, 3) force of the rail on each wheel, left/right (N)
     observers : (n_observers, 3) displacement at each observer (m)
+    pile_displacement : (n_piles, 3) pile-head displacement, area-weighted mean over the
+        head (m), piles in :attr:`Layout.piles` order
+    pile_acceleration : (n_piles, 3) pile-head acceleration (m/s^2)
+    pile_rotation_rate : (n_piles, 3) pile-head rotation rate (rad/s)
+    soil_points : (n_points, 9) ground points: x, y, z (m), displacement (m) and
+        acceleration (m/s^2)
 
     """
 
@@ -65,6 +80,10 @@ class Frame:
     body_angular_velocity: np.ndarray
     wheel_rail: np.ndarray
     observers: np.ndarray
+    pile_displacement: np.ndarray = field(default_factory=lambda: np.zeros((0, 3)))
+    pile_acceleration: np.ndarray = field(default_factory=lambda: np.zeros((0, 3)))
+    pile_rotation_rate: np.ndarray = field(default_factory=lambda: np.zeros((0, 3)))
+    soil_points: np.ndarray = field(default_factory=lambda: np.zeros((0, 9)))
 
     @property
     def stamp_ns(self) -> int:
