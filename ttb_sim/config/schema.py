@@ -26,6 +26,7 @@ from __future__ import annotations
 import dataclasses
 import math
 import sys
+import typing
 from typing import Any, Iterator, Mapping
 
 from ttb_sim.errors import ModelError, ScenarioError
@@ -176,6 +177,13 @@ def from_mapping(data: Mapping[str, Any], cls: type | None = None, prefix: str =
 
 def _coerce(path: str, value: Any, typ: Any, spec: Spec) -> Any:
     """Check one value against its declared type and range, and return it typed."""
+    record = _record_item(typ)
+    if record is not None:
+        if not isinstance(value, (list, tuple)) or not value:
+            raise ScenarioError(f'{path} = {_short(value)}: expected a non-empty list of '
+                                f'mappings with keys {_field_names(record)}')
+        return tuple(from_mapping(item, record, prefix=f'{path}[{i}].')
+                     for i, item in enumerate(value))
     if typ in (tuple[float, ...],):
         if not isinstance(value, (list, tuple)):
             raise ScenarioError(f'{path} = {value!r}: expected a list of numbers ({spec.unit})')
@@ -199,6 +207,25 @@ def _coerce(path: str, value: Any, typ: Any, spec: Spec) -> Any:
     if typ in (float, int):
         return _coerce_number(path, value, typ, spec)
     raise TypeError(f'unsupported schema type {typ!r} for {path}')  # pragma: no cover
+
+
+def _record_item(typ: Any) -> type | None:
+    """Return X for a ``tuple[X, ...]`` of declared records, else None."""
+    args = typing.get_args(typ)
+    if (typing.get_origin(typ) is tuple and len(args) == 2 and args[1] is Ellipsis
+            and dataclasses.is_dataclass(args[0]) and isinstance(args[0], type)):
+        return args[0]
+    return None
+
+
+def _field_names(record: type) -> str:
+    return ', '.join(f.name for f in dataclasses.fields(record))
+
+
+def _short(value: Any, limit: int = 200) -> str:
+    """Return repr(value), cut to ``limit`` characters with a note."""
+    text = repr(value)
+    return text if len(text) <= limit else f'{text[:limit]}... ({len(text)} characters)'
 
 
 def _coerce_number(path: str, value: Any, typ: type, spec: Spec) -> float | int:
