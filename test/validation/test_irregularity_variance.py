@@ -24,7 +24,6 @@ The PSDs themselves are checked against the PHYSICS.md formulas in
 from __future__ import annotations
 
 import pytest
-from scipy import integrate
 
 from ttb_sim.model.irregularity import spectra
 from ttb_sim.validation.references import irregularity as variance
@@ -32,17 +31,8 @@ from ttb_sim.validation.references import irregularity as variance
 ALL_COMPONENTS = [(f, c) for f, fam in spectra.SPECTRA.items() for c in fam.components]
 
 
-def quad_variance(comp: spectra.SpectrumComponent, lam_min: float, lam_max: float) -> float:
-    """Integrate G over [1/lam_max, 1/lam_min] with scipy quad (m^2)."""
-    n_lo, n_hi = 1.0 / lam_max, 1.0 / lam_min
-    inner = [b for b in comp.breakpoints if n_lo < b < n_hi] or None
-    value, _ = integrate.quad(lambda n: float(comp.psd(n)), n_lo, n_hi, points=inner,
-                              limit=400, epsabs=0.0, epsrel=1e-10)
-    return value
-
-
 @pytest.mark.parametrize(('family', 'component'), ALL_COMPONENTS)
-def test_v8_ensemble_variance_equals_psd_integral(family, component):
+def test_v8_ensemble_variance_equals_psd_integral(family, component, quad_variance):
     """
     V8: mean sample variance of 20 realisations equals the integral of G over the band.
 

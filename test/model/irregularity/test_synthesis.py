@@ -28,7 +28,7 @@ import time
 
 import numpy as np
 import pytest
-from scipy import integrate, signal
+from scipy import signal
 
 from ttb_sim.errors import ModelError
 from ttb_sim.model.irregularity import spectra, synthesis
@@ -36,16 +36,7 @@ from ttb_sim.model.irregularity import spectra, synthesis
 ALL_COMPONENTS = [(f, c) for f, fam in spectra.SPECTRA.items() for c in fam.components]
 
 
-def quad_variance(comp: spectra.SpectrumComponent, lam_min: float, lam_max: float) -> float:
-    """Integrate G over [1/lam_max, 1/lam_min] with scipy quad (m^2)."""
-    n_lo, n_hi = 1.0 / lam_max, 1.0 / lam_min
-    inner = [b for b in comp.breakpoints if n_lo < b < n_hi] or None
-    value, _ = integrate.quad(lambda n: float(comp.psd(n)), n_lo, n_hi, points=inner,
-                              limit=400, epsabs=0.0, epsrel=1e-10)
-    return value
-
-
-def test_v8_paper_preset_adds_chinese_and_sato():
+def test_v8_paper_preset_adds_chinese_and_sato(quad_variance):
     """
     V8 for the paper preset: vertical variance = Chinese (1-50 m) + Sato (0.05-1 m).
 
@@ -69,7 +60,7 @@ def test_v8_paper_preset_adds_chinese_and_sato():
         assert np.var(prof.geometry(c)) == pytest.approx(var, rel=exact)
 
 
-def test_chinese_sato_preset_extends_the_chinese_band_to_200_m():
+def test_chinese_sato_preset_extends_the_chinese_band_to_200_m(quad_variance):
     """
     chinese_sato = paper preset with the Chinese layer over 1-200 m (V8 variance, 2 %).
 
@@ -122,7 +113,7 @@ def test_v9_welch_psd_matches_target_per_octave(family, component):
         assert ratio == pytest.approx(1.0, abs=0.20)
 
 
-def test_short_track_has_the_right_variance_on_average():
+def test_short_track_has_the_right_variance_on_average(quad_variance):
     """
     A track shorter than the FFT record is a window of it: mean square over seeds.
 
@@ -162,7 +153,7 @@ def test_rail_composition_and_signs():
     np.testing.assert_allclose(full.values, total, rtol=0.0, atol=1e-15)
 
 
-def test_paper_preset_sato_is_common_to_both_rails():
+def test_paper_preset_sato_is_common_to_both_rails(quad_variance):
     """
     Paper preset = Chinese vertical + alignment 1-50 m + Sato 0.05-1 m on both rails' vertical.
 
