@@ -12,4 +12,14 @@
 # See the License for the specific language governing permissions and
 # limitations under the License.
 
-"""ttb_sim.analysis package."""
+"""
+Post-processing of frames and bag arrays (never imports the model).
+
+``psd``: Welch PSD with windows long enough for the lowest frequency of interest,
+zero-padded periodograms, peak and level-change frequencies.
+"""
+
+from ttb_sim.analysis.psd import (level_change_frequency, padded_periodogram, peak_frequency,
+                                  welch_psd)
+
+__all__ = ['level_change_frequency', 'padded_periodogram', 'peak_frequency', 'welch_psd']

@@ -12,4 +12,10 @@
 # See the License for the specific language governing permissions and
 # limitations under the License.
 
-"""commands: see the modules of this package."""
+"""
+The ROS-free verbs of ``ttb-sim``: run, validate, scenarios, bench.
+
+Each verb is a function that takes plain arguments, prints what a user reads and
+returns the exit code; ``cli.py`` only parses arguments and maps errors to exit
+codes, and tests call the verbs directly.
+"""

@@ -12,4 +12,17 @@
 # See the License for the specific language governing permissions and
 # limitations under the License.
 
-"""ttb_sim.fe package."""
+"""
+Finite elements without physics names: elements, assembly, numbering, factorisation.
+
+``beam`` (3-D Euler-Bernoulli), ``mindlin`` (MITC4 plate), ``assembly`` (COO-once
+sparse assembly and spring-dashpot links), ``dofs`` (:class:`DofMap`: full/free
+numbering, substructure blocks and interfaces), ``factorization`` (symmetric sparse
+direct solvers behind one function).
+"""
+
+from ttb_sim.fe.assembly import assemble, assemble_links, link_kinematics
+from ttb_sim.fe.dofs import DofMap
+from ttb_sim.fe.factorization import factorize
+
+__all__ = ['assemble', 'assemble_links', 'DofMap', 'factorize', 'link_kinematics']

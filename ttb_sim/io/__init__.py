@@ -12,4 +12,17 @@
 # See the License for the specific language governing permissions and
 # limitations under the License.
 
-"""ttb_sim.io package."""
+"""
+Input and output: the topic table, the rosbag2 recorder and the bag reader.
+
+``topics`` maps frames to standard ROS 2 messages (one table for the node and the
+bags), ``bag`` records frames to rosbag2 (MCAP or SQLite 3), ``reader`` reads any
+bag of ours back into numpy arrays per topic.
+"""
+
+from ttb_sim.io.bag import BagRecorder, default_bag_path, STORAGES
+from ttb_sim.io.reader import bag_topics, read_bag, TopicArrays
+from ttb_sim.io.topics import FRAME_ID, NAMESPACE, PeakTracker, Topic, topic_table
+
+__all__ = ['bag_topics', 'BagRecorder', 'default_bag_path', 'FRAME_ID', 'NAMESPACE',
+           'PeakTracker', 'read_bag', 'STORAGES', 'Topic', 'topic_table', 'TopicArrays']

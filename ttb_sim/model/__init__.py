@@ -12,4 +12,10 @@
 # See the License for the specific language governing permissions and
 # limitations under the License.
 
-"""ttb_sim.model package."""
+"""
+The physical model: vehicles, wheel-rail contact, irregularity, track, bridge.
+
+Model modules take their own parameter records (declared with
+:func:`ttb_sim.parameters.param`) and never see the scenario tree; bad physical
+arguments raise :class:`ttb_sim.errors.ModelError`.
+"""

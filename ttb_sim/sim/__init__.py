@@ -12,4 +12,17 @@
 # See the License for the specific language governing permissions and
 # limitations under the License.
 
-"""ttb_sim.sim package."""
+"""
+The stepping core: build step, integrators, couplings, the simulation loop, frames.
+
+``build`` turns a scenario into model objects (the only reader of the scenario
+tree), ``integrators`` holds the integrator protocol and Newmark, ``coupling`` the
+vehicle-structure couplings behind one protocol, ``simulation`` the one stepping
+loop that yields :class:`Frame` objects, ``variants`` and ``lean`` the solver
+variants.
+"""
+
+from ttb_sim.sim.frames import Frame, Layout
+from ttb_sim.sim.simulation import Simulation
+
+__all__ = ['Frame', 'Layout', 'Simulation']

@@ -12,4 +12,10 @@
 # See the License for the specific language governing permissions and
 # limitations under the License.
 
-"""ttb_sim.validation package."""
+"""
+Validation: closed-form references and the cases of ``ttb-sim validate``.
+
+``references`` holds the independent closed forms (sharing no code with the FE
+path), ``cases`` runs each case through the user pipeline (scenario -> model ->
+solver -> frames) and compares, ``rows`` is the table row of a comparison.
+"""

@@ -12,4 +12,17 @@
 # See the License for the specific language governing permissions and
 # limitations under the License.
 
-"""coupling: see the modules of this package."""
+"""
+Vehicle-structure couplings behind one protocol (:class:`Coupling`).
+
+Moving forces (no vehicle dynamics), quarter cars on the girders, and 42-DOF
+multibody cars on the slab track through wheel-rail contact.
+"""
+
+from ttb_sim.sim.coupling.base import Coupling, girder_wheel_load, VehicleOutputs
+from ttb_sim.sim.coupling.moving_force import MovingForceCoupling
+from ttb_sim.sim.coupling.quarter_car import QuarterCarCoupling, QuarterCarTrain
+from ttb_sim.sim.coupling.train_track import TrainTrackCoupling
+
+__all__ = ['Coupling', 'girder_wheel_load', 'MovingForceCoupling', 'QuarterCarCoupling',
+           'QuarterCarTrain', 'TrainTrackCoupling', 'VehicleOutputs']

@@ -12,4 +12,9 @@
 # See the License for the specific language governing permissions and
 # limitations under the License.
 
-"""cases: see the modules of this package."""
+"""
+The validation cases, run through the user pipeline; ``registry`` lists them by id.
+
+``components`` (car eigen-analysis, Hertz, irregularity synthesis), ``track`` (V2,
+V6), ``system`` (V19), ``slab_plate`` (X1); V1, V3 and V7 live in ``registry``.
+"""
