@@ -319,11 +319,136 @@ def rayleigh_coefficients(ratio: float, f1: float, f2: float) -> tuple[float, fl
     return 2 * ratio * w1 * w2 / (w1 + w2), 2 * ratio / (w1 + w2)
 
 
+@dataclass(frozen=True)
+class BeamBlock:
+    """A substructure of beam elements in the global node numbering."""
+
+    coords: np.ndarray
+    """(n_nodes, 3) coordinates of the block's own nodes (m)."""
+    elements: np.ndarray
+    """(n_el, 2) global node numbers of each element."""
+    section: BeamSection
+    """Section of each element."""
+
+
+def girder_block(b: BridgeParameters) -> tuple[BeamBlock, np.ndarray]:
+    """
+    Return the girders (nodes 0.., ``elements_per_span`` elements per span) and their nodes.
+
+    Returns
+    -------
+    (BeamBlock, (n_spans, ne + 1) node numbers of each span)
+
+    """
+    n_spans, ne, span = b.n_spans, b.elements_per_span, b.span_length
+    xg = (np.arange(n_spans)[:, None] * span
+          + np.linspace(0.0, span, ne + 1)[None, :]).ravel()
+    girder_nodes = np.arange(n_spans * (ne + 1)).reshape(n_spans, ne + 1)
+    first = girder_nodes[:, :-1].ravel()
+    elements = np.column_stack([first, first + 1])
+    section = _uniform_section(elements.shape[0], b.axial_stiffness, b.torsional_stiffness,
+                               b.bending_stiffness, b.lateral_bending_stiffness,
+                               b.mass_per_length, b.torsional_inertia)
+    coords = np.column_stack([xg, np.zeros_like(xg), np.zeros_like(xg)])
+    return BeamBlock(coords, elements, section), girder_nodes
+
+
+def pier_block(pr: PierParameters, n_spans: int, span: float,
+               first_node: int) -> tuple[BeamBlock, np.ndarray, np.ndarray]:
+    """
+    Return the pier columns under the intermediate supports (top node first).
+
+    Returns
+    -------
+    (BeamBlock, pier top node per support, pier base node per support); -1 where a
+    support (the abutments) has no pier.
+
+    """
+    n_supports = n_spans + 1
+    pier_top = np.full(n_supports, -1)
+    pier_base = np.full(n_supports, -1)
+    npe = pr.elements
+    zp = -np.linspace(0.0, pr.height, npe + 1)
+    coords, conn = [np.zeros((0, 3))], [np.zeros((0, 2), dtype=int)]
+    n_nodes = first_node
+    for s in range(1, n_spans):
+        ids = n_nodes + np.arange(npe + 1)
+        coords.append(np.column_stack([np.full(npe + 1, s * span), np.zeros(npe + 1), zp]))
+        conn.append(np.column_stack([ids[:-1], ids[1:]]))
+        pier_top[s], pier_base[s] = ids[0], ids[-1]
+        n_nodes += npe + 1
+    section = _uniform_section((n_spans - 1) * npe, pr.axial_stiffness,
+                               pr.torsional_stiffness, pr.bending_stiffness,
+                               pr.bending_stiffness, pr.mass_per_length, pr.mass_per_length)
+    return BeamBlock(np.concatenate(coords), np.concatenate(conn), section), pier_top, pier_base
+
+
+def _rigid_end_dofs(ends: np.ndarray, end_support: np.ndarray
+                    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Return (full DOF, support, component) of ideal pinned girder ends."""
+    n_spans = ends.shape[0]
+    comp_list, dof_list, sup_list = [], [], []
+    for end in (0, 1):
+        comps = (0, 1, 2, 3) if end == 0 else (1, 2, 3)
+        for c in comps:
+            dof_list.append(ends[:, end] * NODE_DOFS + c)
+            sup_list.append(end_support[:, end])
+            comp_list.append(np.full(n_spans, c))
+    return np.concatenate(dof_list), np.concatenate(sup_list), np.concatenate(comp_list)
+
+
+def _bearing_links(br: BearingParameters, ends: np.ndarray, end_support: np.ndarray,
+                   pier_top: np.ndarray) -> tuple[np.ndarray, ...]:
+    """
+    Return the elastic bearings as links between girder ends and pier tops (or ground).
+
+    Returns
+    -------
+    (kinematics (n, 3, 12), full DOFs (n, 12) with -1 for ground, stiffness (n, 3),
+    damping (n, 3), support (n,), side (n,)), one link per girder end and side.
+
+    """
+    e = br.spacing / 2
+    girder_end = np.repeat(ends.ravel(), 2)               # node, per side
+    support = np.repeat(end_support.ravel(), 2)
+    side = np.tile([0, 1], ends.size)
+    arm = np.column_stack([np.zeros(side.size), np.where(side == 0, e, -e),
+                           np.zeros(side.size)])
+    top = pier_top[support]
+    kin = link_kinematics(arm, np.where((top >= 0)[:, None], arm, 0.0))
+    kdir = np.tile([br.longitudinal_stiffness, br.lateral_stiffness,
+                    br.vertical_stiffness], (side.size, 1))
+    cdir = np.tile([br.lateral_damping, br.lateral_damping, br.vertical_damping],
+                   (side.size, 1))
+    node_b = np.where(top >= 0, top, 0)
+    full_b = node_b[:, None] * NODE_DOFS + np.arange(NODE_DOFS)
+    ground = np.repeat(top < 0, NODE_DOFS).reshape(-1, NODE_DOFS)
+    link_full = np.concatenate([girder_end[:, None] * NODE_DOFS + np.arange(NODE_DOFS),
+                                np.where(ground, -1, full_b)], axis=1)
+    return kin, link_full, kdir, cdir, support, side
+
+
+def _foundation_springs(fd: FoundationParameters, bases: np.ndarray,
+                        n_full: int) -> tuple[sp.csr_matrix, sp.csr_matrix]:
+    """Return (K, C) of the foundation springs under the pier bases."""
+    bdofs = (bases[:, None] * NODE_DOFS + np.arange(NODE_DOFS)).ravel()
+    kf = np.tile([fd.lateral_stiffness, fd.lateral_stiffness, fd.vertical_stiffness,
+                  fd.rotational_stiffness, fd.rotational_stiffness,
+                  fd.rotational_stiffness], bases.size)
+    cf = np.tile([fd.damping, fd.damping, fd.damping, 0.0, 0.0, 0.0], bases.size)
+    return (sp.csr_matrix((kf, (bdofs, bdofs)), shape=(n_full, n_full)),
+            sp.csr_matrix((cf, (bdofs, bdofs)), shape=(n_full, n_full)))
+
+
 def assemble_structure(b: BridgeParameters, br: BearingParameters, pr: PierParameters,
                        fd: FoundationParameters, track_parameters: TrackParameters | None,
                        train_length: float) -> Structure:
     """
     Assemble girders, bearings, piers, foundations and the slab track (once).
+
+    The substructures are built as blocks of the global numbering (girders, then
+    piers, then track) and meet at the named interfaces of the :class:`DofMap`:
+    ``bearings`` (girder ends and pier tops) and ``foundations`` (pier bases).
 
     Parameters
     ----------
@@ -341,51 +466,34 @@ def assemble_structure(b: BridgeParameters, br: BearingParameters, pr: PierParam
     """
     n_spans, ne, span = b.n_spans, b.elements_per_span, b.span_length
     n_supports = n_spans + 1
-    piers = fd.model == 'springs'
-
-    # Nodes: girders first (ne + 1 per span), then pier columns (top node first).
-    xg = (np.arange(n_spans)[:, None] * span
-          + np.linspace(0.0, span, ne + 1)[None, :]).ravel()
-    coords = [np.column_stack([xg, np.zeros_like(xg), np.zeros_like(xg)])]
-    girder_nodes = np.arange(n_spans * (ne + 1)).reshape(n_spans, ne + 1)
-    first = girder_nodes[:, :-1].ravel()
-    conn = [np.column_stack([first, first + 1])]
-    sections = [_uniform_section(conn[0].shape[0], b.axial_stiffness, b.torsional_stiffness,
-                                 b.bending_stiffness, b.lateral_bending_stiffness,
-                                 b.mass_per_length, b.torsional_inertia)]
-    n_nodes = girder_nodes.size
+    girders, girder_nodes = girder_block(b)
+    blocks = [girders]
+    n_girder_nodes = girder_nodes.size
     pier_top = np.full(n_supports, -1)
     pier_base = np.full(n_supports, -1)
-    if piers:
-        npe = pr.elements
-        zp = -np.linspace(0.0, pr.height, npe + 1)
-        for s in range(1, n_spans):
-            ids = n_nodes + np.arange(npe + 1)
-            coords.append(np.column_stack([np.full(npe + 1, s * span),
-                                           np.zeros(npe + 1), zp]))
-            conn.append(np.column_stack([ids[:-1], ids[1:]]))
-            pier_top[s], pier_base[s] = ids[0], ids[-1]
-            n_nodes += npe + 1
-        n_pier_el = (n_spans - 1) * npe
-        if n_pier_el:
-            sections.append(_uniform_section(n_pier_el, pr.axial_stiffness,
-                                             pr.torsional_stiffness, pr.bending_stiffness,
-                                             pr.bending_stiffness, pr.mass_per_length,
-                                             pr.mass_per_length))
-    n_bridge_el = sum(c.shape[0] for c in conn)
-    girder_el = conn[0]
-    girder_el_dofs = (girder_el[:, :, None] * NODE_DOFS + np.arange(NODE_DOFS)).reshape(-1, 12)
-    girder_beam = BeamLine(start=xg[girder_el[:, 0]], length=np.full(len(girder_el), span / ne),
+    if fd.model == 'springs':
+        piers, pier_top, pier_base = pier_block(pr, n_spans, span, n_girder_nodes)
+        if piers.elements.size:
+            blocks.append(piers)
+    n_bridge_nodes = n_girder_nodes + sum(blk.coords.shape[0] for blk in blocks[1:])
+    n_bridge_el = sum(blk.elements.shape[0] for blk in blocks)
+    girder_el_dofs = (girders.elements[:, :, None] * NODE_DOFS
+                      + np.arange(NODE_DOFS)).reshape(-1, 12)
+    girder_beam = BeamLine(start=girders.coords[girders.elements[:, 0], 0],
+                           length=np.full(len(girders.elements), span / ne),
                            dofs=girder_el_dofs, z=0.0)
     track = None
+    sections = [blk.section for blk in blocks]
+    coords = [blk.coords for blk in blocks]
+    conn = [blk.elements for blk in blocks]
     if track_parameters is not None:
-        track = build_track(track_parameters, span * n_spans, train_length, n_nodes,
+        track = build_track(track_parameters, span * n_spans, train_length, n_bridge_nodes,
                             girder_beam)
         coords.append(track.coords)
         conn.append(track.elements)
         sections.append(track.sections)
-        n_nodes += track.coords.shape[0]
     xyz = np.concatenate(coords)
+    n_nodes = xyz.shape[0]
     elements = np.concatenate(conn)
     section = BeamSection(*(np.concatenate([getattr(s, f) for s in sections])
                             for f in ('ea', 'gj', 'ei_y', 'ei_z', 'mass', 'inertia_x')))
@@ -410,60 +518,32 @@ def assemble_structure(b: BridgeParameters, br: BearingParameters, pr: PierParam
             c_full = c_full + assemble_links(n_full, links.dofs, links.kinematics,
                                              links.damping)
 
-    # Supports.
+    # Interfaces: bearings between girder ends and supports, foundations under piers.
     constrained = np.zeros(n_full, dtype=bool)
     ends = np.stack([girder_nodes[:, 0], girder_nodes[:, -1]], axis=1)  # (n_spans, 2)
     end_support = np.stack([np.arange(n_spans), np.arange(1, n_spans + 1)], axis=1)
     bearing_links = None
     if br.model == 'rigid':
-        comp_list, dof_list, sup_list = [], [], []
-        for end in (0, 1):
-            comps = (0, 1, 2, 3) if end == 0 else (1, 2, 3)
-            for c in comps:
-                dof_list.append(ends[:, end] * NODE_DOFS + c)
-                sup_list.append(end_support[:, end])
-                comp_list.append(np.full(n_spans, c))
-        cdofs = np.concatenate(dof_list)
+        cdofs, c_support, c_component = _rigid_end_dofs(ends, end_support)
         constrained[cdofs] = True
     else:
-        e = br.spacing / 2
-        girder_end = np.repeat(ends.ravel(), 2)               # node, per side
-        support = np.repeat(end_support.ravel(), 2)
-        side = np.tile([0, 1], ends.size)
-        arm = np.column_stack([np.zeros(side.size), np.where(side == 0, e, -e),
-                               np.zeros(side.size)])
-        top = pier_top[support]
-        kin = link_kinematics(arm, np.where((top >= 0)[:, None], arm, 0.0))
-        kdir = np.tile([br.longitudinal_stiffness, br.lateral_stiffness,
-                        br.vertical_stiffness], (side.size, 1))
-        cdir = np.tile([br.lateral_damping, br.lateral_damping, br.vertical_damping],
-                       (side.size, 1))
-        node_b = np.where(top >= 0, top, 0)
-        full_b = node_b[:, None] * NODE_DOFS + np.arange(NODE_DOFS)
-        ground = np.repeat(top < 0, NODE_DOFS).reshape(-1, NODE_DOFS)
-        link_full = np.concatenate([girder_end[:, None] * NODE_DOFS + np.arange(NODE_DOFS),
-                                    np.where(ground, -1, full_b)], axis=1)
+        bearing_links = _bearing_links(br, ends, end_support, pier_top)
+        kin, link_full, kdir, cdir = bearing_links[:4]
         k_full = k_full + assemble_links(n_full, link_full, kin, kdir)
         c_full = c_full + assemble_links(n_full, link_full, kin, cdir)
-        bearing_links = (kin, link_full, kdir, cdir, support, side)
-    if piers and n_spans > 1:
-        base = pier_base[1:n_spans]
-        bdofs = (base[:, None] * NODE_DOFS + np.arange(NODE_DOFS)).ravel()
-        kf = np.tile([fd.lateral_stiffness, fd.lateral_stiffness, fd.vertical_stiffness,
-                      fd.rotational_stiffness, fd.rotational_stiffness,
-                      fd.rotational_stiffness], base.size)
-        cf = np.tile([fd.damping, fd.damping, fd.damping, 0.0, 0.0, 0.0], base.size)
-        k_full = k_full + sp.csr_matrix((kf, (bdofs, bdofs)), shape=(n_full, n_full))
-        c_full = c_full + sp.csr_matrix((cf, (bdofs, bdofs)), shape=(n_full, n_full))
+    bases = pier_base[pier_base >= 0]
+    if bases.size:
+        k_found, c_found = _foundation_springs(fd, bases, n_full)
+        k_full = k_full + k_found
+        c_full = c_full + c_found
 
-    n_girder_nodes = girder_nodes.size
-    n_pier_nodes = int(np.count_nonzero(pier_top >= 0)) * (pr.elements + 1) if piers else 0
-    blocks = {'girders': np.arange(n_girder_nodes),
-              'piers': n_girder_nodes + np.arange(n_pier_nodes),
-              'track': np.arange(n_girder_nodes + n_pier_nodes, n_nodes)}
-    interfaces = {'bearings': np.concatenate([ends.ravel(), pier_top[pier_top >= 0]]),
-                  'foundations': pier_base[pier_base >= 0]}
-    dof_map = DofMap.compose(n_nodes, NODE_DOFS, constrained, blocks, interfaces)
+    dof_map = DofMap.compose(
+        n_nodes, NODE_DOFS, constrained,
+        {'girders': np.arange(n_girder_nodes),
+         'piers': np.arange(n_girder_nodes, n_bridge_nodes),
+         'track': np.arange(n_bridge_nodes, n_nodes)},
+        {'bearings': np.concatenate([ends.ravel(), pier_top[pier_top >= 0]]),
+         'foundations': bases})
     free, full_to_free = dof_map.free, dof_map.full_to_free
     n_free = dof_map.n_free
 
@@ -477,8 +557,7 @@ def assemble_structure(b: BridgeParameters, br: BearingParameters, pr: PierParam
             return sp.hstack([r, sp.csc_matrix((cdofs.size, 1))]).tocsr()
 
         rigid = RigidSupports(rows_k=rows(k_full), rows_c=rows(c_full), rows_m=rows(m_full),
-                              full_dofs=cdofs, support=np.concatenate(sup_list),
-                              component=np.concatenate(comp_list))
+                              full_dofs=cdofs, support=c_support, component=c_component)
     bearings = None
     if bearing_links is not None:
         kin, link_full, kdir, cdir, support, side = bearing_links
@@ -486,7 +565,7 @@ def assemble_structure(b: BridgeParameters, br: BearingParameters, pr: PierParam
         bearings = Bearings(kinematics=kin, dofs=ext, stiffness=kdir, damping=cdir,
                             support=support, side=side)
 
-    el_nodes = conn[0]
+    el_nodes = girders.elements
     wfull = el_nodes[:, [0, 0, 1, 1]] * NODE_DOFS + W_DOFS % NODE_DOFS
     girder = GirderLine(span_length=span, n_spans=n_spans, elements_per_span=ne,
                         w_dofs=full_to_free[wfull], w_dofs_full=wfull)
