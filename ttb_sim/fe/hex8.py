@@ -124,6 +124,27 @@ def stiffness(coords: np.ndarray, young: np.ndarray, poisson: np.ndarray) -> np.
 
     """
     grad, det = _jacobians(np.asarray(coords, dtype=float))
+    m = len(grad)
+    young = np.asarray(young, dtype=float)
+    poisson = np.broadcast_to(np.asarray(poisson, dtype=float), young.shape)
+    lam = young * poisson / ((1 + poisson) * (1 - 2 * poisson))
+    mu = young / (2 * (1 + poisson))
+    # A[a i, b j] = sum_g w det g_ai g_bj; K_aibj = lam A_aibj + mu A_ajbi + mu delta_ij A_akbk
+    g = grad.reshape(m, 8, 24)
+    a = np.matmul(np.swapaxes(g * (det * GAUSS_WEIGHTS)[:, :, None], 1, 2), g)
+    a5 = a.reshape(m, 8, 3, 8, 3)
+    trace = np.einsum('eaibi->eab', a5)
+    k = lam[:, None, None, None, None] * a5 + mu[:, None, None, None, None] * \
+        np.swapaxes(a5, 2, 4)
+    idx = np.arange(3)
+    k[:, :, idx, :, idx] += mu[None, :, None, None] * trace[None]
+    return k.reshape(m, 24, 24)
+
+
+def stiffness_reference(coords: np.ndarray, young: np.ndarray,
+                        poisson: np.ndarray) -> np.ndarray:
+    """Return K_e = sum_g w_g det J_g B_g^T D B_g with explicit B matrices (slow; for tests)."""
+    grad, det = _jacobians(np.asarray(coords, dtype=float))
     b = strain_matrices(grad)
     d = elasticity(young, poisson)
     db = np.matmul(d[:, None], b)

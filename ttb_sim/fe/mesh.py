@@ -246,7 +246,8 @@ def graded_planes(start: float, stop: float, keys: Sequence[float],
         d = np.full_like(x, np.inf)
         for a, b in zones:
             d = np.minimum(d, np.maximum(0.0, np.maximum(a - x, x - b)))
-        s = np.minimum(h_max, h + (growth - 1.0) * d)
+        s = np.where(np.isinf(d), h_max, np.minimum(h_max, h + (growth - 1.0) * np.where(
+            np.isinf(d), 0.0, d)))
         for a, b, largest in limits:
             s = np.where((x >= a - tol) & (x <= b + tol), np.minimum(s, largest), s)
         return s
