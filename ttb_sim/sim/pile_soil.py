@@ -44,7 +44,9 @@ product with the soil matrices plus a small solve on the pile DOFs.
 Interface nonlinearity: inside each step the implicit equations are solved
 by Newton iterations, either with the once-factorised initial tangent
 (``newton='modified'``, the default: the Desai tangent only softens, so the
-initial-stiffness iteration contracts) or with the current tangent
+initial-stiffness iteration contracts; when a step needs more than 15
+iterations, as under heavy slip, the current tangent is factorised for the
+rest of that step) or with the current tangent
 refactorised at each iteration (``newton='full'``, for checking). The Desai
 plastic slip is committed when the step has converged. Output is one
 :class:`PileSoilFrame` per output interval.
@@ -227,6 +229,7 @@ class PartitionedNewmark:
         self.newton = newton
         self.tolerance = tolerance
         self.max_iterations = max_iterations
+        self.refresh_after = 15
         n = model.n_dofs
         free = model.free
         implicit = np.zeros(n, dtype=bool)
@@ -295,7 +298,9 @@ class PartitionedNewmark:
         u_i0, v_i0 = u_p[idx], v_p[idx]
         nonlinear = model.interface is not None and state.slip is not None
         u_full = u_p.copy()
-        scale = max(float(np.linalg.norm(r_i)), float(np.linalg.norm(force)), 1e-30)
+        scale = max(float(np.linalg.norm(r_i)), float(np.linalg.norm(force)),
+                    float(np.linalg.norm(self.m_i * state.a[idx])),
+                    float(np.linalg.norm(self.k_i @ u_i0)), 1e-30)
         factor = self._factor
         new_slip = state.slip
         for it in range(self.max_iterations):
@@ -308,7 +313,8 @@ class PartitionedNewmark:
                 residual -= f_ifc[idx]
                 if np.linalg.norm(residual) <= self.tolerance * scale:
                     break
-                if self.newton == 'full' and tangent is not None:
+                refresh = self.newton == 'full' or (it > 0 and it % self.refresh_after == 0)
+                if refresh and tangent is not None:
                     assert model.interface is not None
                     k_t = model.interface.stiffness(tangent)[idx][:, idx]
                     factor = _Factor(self._matrix(k_t))

@@ -159,8 +159,9 @@ def single_pile(h: float = 0.443, growth: float = 1.3, h_max: float = 3.0,
 def head_stiffness(spec: Substructure, force: float = 1e3) -> float:
     """Return the static vertical head stiffness F / w (N/m) through :func:`run`."""
     model = build(spec)
-    frame = next(run(model, PileLoad('static', force, pile=1), 0.0))
-    return force / float(frame.pile_displacement[0, 2])
+    state = static_solve(model, model.load_vector(PileLoad('static', force, pile=1)),
+                         increments=1)
+    return force / float(observe(model, state).pile_displacement[0, 2])
 
 
 def randolph_wroth_reference(spec: Substructure) -> float:
