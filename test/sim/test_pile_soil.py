@@ -24,7 +24,7 @@ import pytest
 from ttb_sim.model.foundation.records import (Interface, MeshSize, Observation, PAPER_LAYERS,
                                               PileGroup, PileLoad, SoilBlock, Substructure)
 from ttb_sim.model.foundation.substructure import build
-from ttb_sim.sim.pile_soil import (observe, PartitionedNewmark, initial_state, run,
+from ttb_sim.sim.pile_soil import (initial_state, observe, PartitionedNewmark, run,
                                    stable_time_step, states)
 from ttb_sim.validation.pile_soil_cases import (boundary_reflection, head_stiffness,
                                                 randolph_wroth_reference, single_pile)

@@ -34,7 +34,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from ttb_sim.fe.assembly import assemble
-from ttb_sim.fe.quad import FACE_N, face_frames
+from ttb_sim.fe.quad import face_frames, FACE_N
 
 Lumping = Literal['lumped', 'consistent']
 
@@ -82,8 +82,8 @@ def face_matrices(coords: np.ndarray, normal_value: np.ndarray,
     block = (kn - kt) * n[..., :, None] * n[..., None, :] + kt * np.eye(3)
     if lumping == 'lumped':
         area = np.einsum('ga,eg->ea', FACE_N, weights)
-        nodal = np.einsum('ea,egij,eg->eaij', area, block, weights) / weights.sum(1)[:, None,
-                                                                                  None, None]
+        total = weights.sum(1)[:, None, None, None]
+        nodal = np.einsum('ea,egij,eg->eaij', area, block, weights) / total
         out = np.zeros((len(coords), 12, 12))
         for a in range(4):
             out[:, 3 * a:3 * a + 3, 3 * a:3 * a + 3] = nodal[:, a]

@@ -153,7 +153,7 @@ def stiffness_reference(coords: np.ndarray, young: np.ndarray,
 
 
 def volumes(coords: np.ndarray) -> np.ndarray:
-    """Return element volumes (m^3), shape (m,)."""
+    """Return the volume of each element (m^3)."""
     _, det = _jacobians(np.asarray(coords, dtype=float))
     return det @ GAUSS_WEIGHTS
 

@@ -43,7 +43,7 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.sparse as sp
 
-from ttb_sim.fe.quad import FACE_N, face_frames
+from ttb_sim.fe.quad import face_frames, FACE_N
 
 
 @dataclass(frozen=True)
@@ -85,7 +85,7 @@ class InterfaceSet:
         return 4 * self.n_elements
 
     def strain(self, u: np.ndarray) -> np.ndarray:
-        """Return the layer strain (n, s1, s2) = relative displacement / t, shape (k, 4, 3)."""
+        """Return the layer strain, relative displacement over t, shape (k, 4, 3), axes n s1 s2."""
         rel = (self.relative @ u).reshape(self.n_elements, 4, 3)
         return rel / self.thickness[:, None, None]
 

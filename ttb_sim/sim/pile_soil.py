@@ -222,7 +222,7 @@ class PartitionedNewmark:
     def __init__(self, model: PileSoilModel, dt: float,
                  scheme: Literal['mixed', 'implicit'] = 'mixed',
                  newton: Literal['modified', 'full'] = 'modified',
-                 tolerance: float = 1e-8, max_iterations: int = 100) -> None:
+                 tolerance: float = 1e-6, max_iterations: int = 100) -> None:
         self.model = model
         self.dt = float(dt)
         self.scheme = scheme
@@ -279,7 +279,7 @@ class PartitionedNewmark:
                 + 0.25 * dt * dt * (self.k_i + k_ifc)).tocsr()
 
     def step(self, state: State, force: np.ndarray) -> State:
-        """Advance one step; ``force`` is the load at the end of the step (N)."""
+        """Advance the state by one step; ``force`` is the load at the step end (N)."""
         dt = self.dt
         model = self.model
         u_p = state.u + dt * state.v + 0.25 * dt * dt * state.a
@@ -456,7 +456,7 @@ def states(model: PileSoilModel, force: np.ndarray, history: Callable[[float], f
 
 def default_output_dt(load: PileLoad) -> float:
     """Return 1/20 of the load period (s), or 5 ms for a static load."""
-    if load.type == 'static':
+    if load.kind == 'static':
         return 0.005
     return 1.0 / (20.0 * load.frequency)
 
@@ -470,7 +470,7 @@ def run(model: PileSoilModel, load: PileLoad, duration: float,
     harmonic or pulse load starts from rest at t = 0.
     """
     force = model.load_vector(load)
-    if load.type == 'static':
+    if load.kind == 'static':
         yield observe(model, static_solve(model, force))
         return
     dt = default_output_dt(load) if output_dt is None else output_dt

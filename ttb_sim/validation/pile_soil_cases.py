@@ -64,7 +64,7 @@ from ttb_sim.model.foundation.records import (Interface, MeshSize, Observation, 
                                               PileGroup, PileLoad, SoilBlock, SoilLayer,
                                               Substructure)
 from ttb_sim.model.foundation.substructure import build, PileSoilModel
-from ttb_sim.sim.pile_soil import observe, run, static_solve, states
+from ttb_sim.sim.pile_soil import observe, run, states, static_solve
 from ttb_sim.validation.pile_soil_references import (hyperbola_stress, hyperbola_tangent,
                                                      layered_pile_stiffness,
                                                      quarter_wavelength_frequencies,
@@ -174,7 +174,7 @@ def randolph_wroth_reference(spec: Substructure) -> float:
 
 
 def v14() -> list[Row]:
-    """Static head stiffness of a single pile against Randolph-Wroth."""
+    """Compare the static head stiffness of a single pile with Randolph-Wroth."""
     spec = single_pile()
     return [relative_row('V14', 'single-pile head stiffness', head_stiffness(spec),
                          randolph_wroth_reference(spec), 0.15, 'N/m')]

@@ -19,6 +19,8 @@ Refusals name the key, the value and the allowed range; physics checks state
 their reference and tolerance.
 """
 
+from typing import Any
+
 import numpy as np
 import pytest
 
@@ -29,6 +31,8 @@ from ttb_sim.model.foundation.records import (check_substructure, FoundationErro
 from ttb_sim.model.foundation.substructure import build
 from ttb_sim.validation.pile_soil_cases import desai_monotonic
 
+BAD_DIRECTION: Any = 'w'
+
 
 @pytest.mark.parametrize('make, match', [
     (lambda: SoilLayer(2.0, 4e6, 0.5, 1800.0), r'soil\.layers\.nu = 0\.5 .*\[0, 0\.5\)'),
@@ -36,7 +40,7 @@ from ttb_sim.validation.pile_soil_cases import desai_monotonic
     (lambda: PileGroup(spacing=0.8), r'piles\.spacing = 0\.8 .*overlap'),
     (lambda: PileGroup(nu=0.5), r'piles\.nu = 0\.5'),
     (lambda: MeshSize(h=1.0, h_max=0.5), r'soil\.mesh\.h_max = 0\.5'),
-    (lambda: PileLoad(direction='w'), r"load\.direction = 'w' is not one of x, y, z"),
+    (lambda: PileLoad(direction=BAD_DIRECTION), r"load\.direction = 'w' is not one of x, y, z"),
 ])
 def test_bad_records_are_refused(make, match):
     with pytest.raises(FoundationError, match=match):
@@ -51,7 +55,8 @@ def test_bad_combinations_are_refused():
         check_substructure(Substructure(piles=PileGroup(length=25.0)))
     with pytest.raises(FoundationError, match=r'load\.pile = 16'):
         check_substructure(Substructure(), PileLoad(pile=16))
-    with pytest.raises(FoundationError, match=r'load\.frequency = 20 Hz .*soil\.mesh\.h <= 0\.178'):
+    with pytest.raises(FoundationError,
+                       match=r'load\.frequency = 20 Hz .*soil\.mesh\.h <= 0\.178'):
         check_substructure(Substructure(mesh=MeshSize(h=0.5)), PileLoad(frequency=20.0))
 
 

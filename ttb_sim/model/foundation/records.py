@@ -266,7 +266,7 @@ class PileGroup:
         return self.rows * self.cols
 
     def centres(self) -> list[tuple[float, float]]:
-        """Return pile centres (m) in pile-number order (x fastest)."""
+        """Return the plan position of each pile (m), in pile-number order (x fastest)."""
         x0 = self.centre[0] - 0.5 * (self.cols - 1) * self.spacing
         y0 = self.centre[1] - 0.5 * (self.rows - 1) * self.spacing
         return [(x0 + c * self.spacing, y0 + r * self.spacing)
@@ -454,7 +454,8 @@ class PileLoad:
 
     Attributes
     ----------
-    type : {'static', 'harmonic', 'pulse'}
+    kind : {'static', 'harmonic', 'pulse'}
+        (scenario key ``load.type``)
         Constant; A sin(2 pi f t) from t = 0; one half sine of duration 1 / (2 f).
     amplitude : float
         Force (N).
@@ -469,7 +470,7 @@ class PileLoad:
 
     """
 
-    type: LoadType = 'harmonic'
+    kind: LoadType = 'harmonic'
     amplitude: float = 10e3
     frequency: float = 20.0
     pile: int = 5
@@ -477,9 +478,9 @@ class PileLoad:
     target: Literal['pile', 'surface'] = 'pile'
 
     def __post_init__(self) -> None:
-        _choice('load.type', self.type, ('static', 'harmonic', 'pulse'))
+        _choice('load.type', self.kind, ('static', 'harmonic', 'pulse'))
         _check('load.amplitude', self.amplitude)
-        if self.type != 'static':
+        if self.kind != 'static':
             _check('load.frequency', self.frequency, 0.0, low_open=True)
         _check('load.pile', self.pile, 1)
         _choice('load.direction', self.direction, ('x', 'y', 'z'))
@@ -487,10 +488,10 @@ class PileLoad:
 
     def history(self, t: float) -> float:
         """Return the load factor at time t (s)."""
-        if self.type == 'static':
+        if self.kind == 'static':
             return 1.0
         w = 2 * math.pi * self.frequency
-        if self.type == 'harmonic':
+        if self.kind == 'harmonic':
             return math.sin(w * t)
         return math.sin(w * t) if 0.0 <= t <= 0.5 / self.frequency else 0.0
 
@@ -540,13 +541,12 @@ def check_substructure(spec: Substructure, load: Optional[PileLoad] = None) -> N
             if load.pile > count:
                 message = f'load.pile = {load.pile!r}; allowed: 1 .. {count} (piles in group)'
                 raise FoundationError(message)
-        if load.type != 'static':
+        if load.kind != 'static':
             carried = soil.vs_min / (spec.mesh.points_per_wavelength * spec.mesh.h)
+            largest = soil.vs_min / (spec.mesh.points_per_wavelength * load.frequency)
             if load.frequency > carried:
                 message = (f'load.frequency = {load.frequency:g} Hz is above the '
                            f'{carried:.3g} Hz that soil.mesh.h = {spec.mesh.h:g} m carries '
                            f'(Vs_min / ({spec.mesh.points_per_wavelength:g} h)); '
-                           f'allowed: soil.mesh.h <= '
-                           f'{soil.vs_min / (spec.mesh.points_per_wavelength * load.frequency):.3g}'
-                           ' m for this load')
+                           f'allowed: soil.mesh.h <= {largest:.3g} m for this load')
                 raise FoundationError(message)

@@ -56,7 +56,7 @@ from ttb_sim.fe.assembly import assemble
 from ttb_sim.fe.boundary import face_matrices, viscoelastic_coefficients
 from ttb_sim.fe.interface import interface_set, InterfaceSet
 from ttb_sim.fe.mesh import graded_planes, Grid, HEX_FACES, Mesh, node_dofs
-from ttb_sim.fe.quad import FACE_N, face_frames
+from ttb_sim.fe.quad import face_frames, FACE_N
 from ttb_sim.model.foundation.desai import DesaiLaw, initial_moduli
 from ttb_sim.model.foundation.records import (check_substructure, FoundationError, GRAVITY,
                                               PileLoad, Substructure)
@@ -412,11 +412,10 @@ def build(spec: Substructure, load: Optional[PileLoad] = None) -> PileSoilModel:
         mesh.face_sets[name] = faces
         mesh.node_sets[name] = np.unique(faces)
         if soil.boundary == 'fixed':
-            axis = 'xxyyz'[f]
             if name == 'zmin':
                 free[node_dofs(mesh.node_sets[name][:, None]).ravel()] = False
             else:
-                free[3 * mesh.node_sets[name] + 'xyz'.index(axis)] = False
+                free[3 * mesh.node_sets[name] + 'xy'.index(name[0])] = False
             continue
         lay = material[sel]
         g = np.array([soil.layers[m].G for m in lay])
@@ -506,7 +505,7 @@ def build(spec: Substructure, load: Optional[PileLoad] = None) -> PileSoilModel:
              '%d interface elements, f_max %.3g Hz', len(nodes), n_dofs,
              summary['soil_cells'], summary['pile_cells'], summary['cap_cells'],
              summary['interface_elements'], summary['f_max'])
-    if load is not None and load.type != 'static' and load.frequency > summary['f_max']:
+    if load is not None and load.kind != 'static' and load.frequency > summary['f_max']:
         LOG.warning('load frequency %.3g Hz is above the %.3g Hz the coarsest soil elements '
                     'carry: outgoing waves are under-resolved far from the piles',
                     load.frequency, summary['f_max'])
@@ -593,5 +592,4 @@ def _summary(spec: Substructure, mesh: Mesh, kind: np.ndarray, aspect: np.ndarra
         'f_max': float(carried.min()),
         'f_max_estimate': float(spec.soil.vs_min
                                 / (spec.mesh.points_per_wavelength * spec.mesh.h_max)),
-        'grid_shape': tuple(int(n) for n in (len(mesh.nodes),)),
     }
