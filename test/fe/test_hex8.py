@@ -1,0 +1,151 @@
+# Copyright 2026 The ttb_sim Authors
+#
+# Licensed under the Apache License, Version 2.0 (the "License");
+# you may not use this file except in compliance with the License.
+# You may obtain a copy of the License at
+#
+#     http://www.apache.org/licenses/LICENSE-2.0
+#
+# Unless required by applicable law or agreed to in writing, software
+# distributed under the License is distributed on an "AS IS" BASIS,
+# WITHOUT WARRANTIES OR CONDITIONS OF ANY KIND, either express or implied.
+# See the License for the specific language governing permissions and
+# limitations under the License.
+
+"""
+Hexahedron, mesh, interface and boundary elements against closed forms.
+
+References and tolerances are stated per test; exact ones are to round-off.
+"""
+
+import numpy as np
+import pytest
+
+from ttb_sim.fe import hex8
+from ttb_sim.fe.boundary import boundary_matrix, face_matrices
+from ttb_sim.fe.interface import interface_set
+from ttb_sim.fe.mesh import graded_planes, Grid, HEX_FACES, structured_hex
+from ttb_sim.fe.quad import face_area_normals
+
+
+def _distorted_mesh():
+    grid = Grid(np.array([0.0, 0.7, 2.0]), np.array([0.0, 1.1, 2.0]),
+                np.array([-3.0, -1.2, 0.0]))
+    mesh = structured_hex(grid)
+    centre = grid.node_id(1, 1, 1)
+    mesh.nodes[centre] += [0.13, -0.08, 0.11]
+    return mesh, centre
+
+
+def test_fast_stiffness_equals_b_matrix_form():
+    """The gradient form of K equals sum B^T D B on distorted bricks (round-off)."""
+    rng = np.random.default_rng(1)
+    x = hex8.CORNERS[None] * [0.4, 0.9, 1.3] + 0.08 * rng.standard_normal((20, 8, 3))
+    e, nu = rng.uniform(1e6, 1e8, 20), rng.uniform(0.0, 0.45, 20)
+    k, ref = hex8.stiffness(x, e, nu), hex8.stiffness_reference(x, e, nu)
+    assert np.abs(k - ref).max() <= 1e-12 * np.abs(ref).max()
+
+
+def test_patch_test_linear_field_is_exact():
+    """Patch test: a linear displacement on the boundary is reproduced inside (1e-10)."""
+    mesh, centre = _distorted_mesh()
+    n = 3 * mesh.n_nodes
+    k = hex8.assemble_chunked(n, mesh.cell_dofs(), lambda ids: hex8.stiffness(
+        mesh.cell_coordinates(ids), np.full(len(ids), 3e7), np.full(len(ids), 0.3)))
+    grad = np.array([[1e-3, 2e-4, -5e-4], [3e-4, -2e-3, 1e-4], [-1e-4, 4e-4, 7e-4]])
+    exact = (mesh.nodes @ grad.T).ravel()
+    inner = np.arange(3 * centre, 3 * centre + 3)
+    outer = np.setdiff1d(np.arange(n), inner)
+    kd = k.toarray()
+    u_in = np.linalg.solve(kd[np.ix_(inner, inner)], -kd[np.ix_(inner, outer)] @ exact[outer])
+    assert np.allclose(u_in, exact[inner], rtol=0, atol=1e-10 * np.abs(exact).max())
+
+
+def test_bar_under_end_load_matches_fl_over_ea():
+    """Bar (nu = 0) under an end traction: tip displacement F L / (E A) (1e-10)."""
+    grid = Grid(np.linspace(0, 5, 6), np.array([0.0, 0.5]), np.array([0.0, 0.4]))
+    mesh = structured_hex(grid)
+    n = 3 * mesh.n_nodes
+    k = hex8.assemble_chunked(n, mesh.cell_dofs(), lambda ids: hex8.stiffness(
+        mesh.cell_coordinates(ids), np.full(len(ids), 2e9), np.zeros(len(ids))))
+    fixed = np.concatenate([3 * mesh.node_sets['xmin'][:, None] + np.arange(3)]).ravel()
+    tip = mesh.node_sets['xmax']
+    f = np.zeros(n)
+    f[3 * tip] = 1e4 / len(tip)
+    free = np.setdiff1d(np.arange(n), fixed)
+    u = np.zeros(n)
+    u[free] = np.linalg.solve(k.toarray()[np.ix_(free, free)], f[free])
+    assert u[3 * tip] == pytest.approx(np.full(len(tip), 1e4 * 5 / (2e9 * 0.2)), rel=1e-10)
+
+
+def test_lumped_and_consistent_mass_total_rho_v():
+    """Lumped and consistent masses both total rho V on a distorted brick (1e-12)."""
+    mesh, _ = _distorted_mesh()
+    x = mesh.cell_coordinates()
+    rho = np.full(mesh.n_cells, 1900.0)
+    total = 1900.0 * hex8.volumes(x).sum()
+    assert total == pytest.approx(1900.0 * 2 * 2 * 3, rel=1e-12)
+    assert hex8.lumped_mass(x, rho).sum() == pytest.approx(total, rel=1e-12)
+    assert hex8.consistent_mass(x, rho).sum() / 3 == pytest.approx(total, rel=1e-12)
+
+
+def test_structured_faces_point_outward():
+    """Each outer face set's normal points out of the block (exact)."""
+    mesh = structured_hex(Grid(np.array([0.0, 1, 3]), np.array([0.0, 2]), np.array([0.0, 1])))
+    expect = {'xmin': [-1, 0, 0], 'xmax': [1, 0, 0], 'ymin': [0, -1, 0], 'ymax': [0, 1, 0],
+              'zmin': [0, 0, -1], 'zmax': [0, 0, 1]}
+    for name, normal in expect.items():
+        _, n = face_area_normals(mesh.nodes[mesh.face_sets[name]])
+        assert np.allclose(n, normal)
+    assert HEX_FACES.shape == (6, 4)
+
+
+def test_graded_planes_keep_keys_and_growth():
+    """Keys are planes; sizes are <= h in the zone and grow by about growth away from it."""
+    p = graded_planes(-20, 20, [-0.443, 0.443, 3.0], [(-0.443, 0.443)], 0.3, 1.3, 3.0)
+    for key in (-20, -0.443, 0.443, 3.0, 20):
+        assert np.min(np.abs(p - key)) < 1e-12
+    sizes = np.diff(p)
+    assert sizes.max() <= 3.0 + 1e-9
+    inside = (p[:-1] >= -0.443 - 1e-9) & (p[1:] <= 0.443 + 1e-9)
+    assert np.all(sizes[inside] <= 0.3 + 1e-9)
+    far = p[1:] < -1.0
+    assert np.all(sizes[far][:-1] / sizes[far][1:] < 1.35)
+
+
+def test_interface_spring_per_area_is_d_over_t():
+    """A uniform relative displacement d gives traction D d / t: force D d A / t (1e-12)."""
+    nodes = np.array([[0, 0, 0], [2, 0, 0], [2, 3, 0], [0, 3, 0.0]] * 2)
+    s = interface_set(nodes, [[4, 5, 6, 7]], [[0, 1, 2, 3]], 0.05, 24)
+    d = np.array([30e6, 4e6, 5e6])
+    u = np.zeros(24)
+    u[12:24] = np.tile([1e-4, 2e-4, 3e-4], 4)
+    f = s.stiffness(np.tile(d, (1, 4, 1))) @ u
+    # frame rows n = z, s1 = x, s2 = y
+    expect = np.array([d[1] * 1e-4, d[2] * 2e-4, d[0] * 3e-4]) / 0.05 * 6.0
+    assert np.allclose(f[12:].reshape(4, 3).sum(0), expect, rtol=1e-12)
+    assert np.allclose(f[:12].reshape(4, 3).sum(0), -expect, rtol=1e-12)
+    assert np.allclose(s.strain(u)[0], [3e-4 / 0.05, 1e-4 / 0.05, 2e-4 / 0.05])
+    stress = np.tile(d * s.strain(u)[0, 0], (1, 4, 1))
+    assert np.allclose(s.force(stress), f, rtol=1e-12)
+
+
+def test_interface_element_matrix_matches_sparse():
+    """The dense element matrix and the sparse global matrix agree (round-off)."""
+    nodes = np.array([[0, 0, 0], [1, 0, 0.2], [1, 1, 0.1], [0, 1, 0.0]] * 2)
+    s = interface_set(nodes, [[4, 5, 6, 7]], [[0, 1, 2, 3]], 0.02, 24)
+    tangent = np.random.default_rng(3).uniform(1, 2, (1, 4, 3))
+    order = list(range(12, 24)) + list(range(12))
+    k = s.stiffness(tangent).toarray()[np.ix_(order, order)]
+    assert np.allclose(s.element_stiffness(tangent)[0], k, rtol=1e-12, atol=0)
+
+
+def test_boundary_lumped_and_consistent_totals():
+    """Both lumpings carry (k_N + 2 k_T) A in total; K = (k_N - k_T) nn + k_T I per node."""
+    nodes = np.array([[0, 0, 0], [0, 2, 0], [0, 2, 3], [0, 0, 3.0]])
+    for lumping in ('lumped', 'consistent'):
+        k = boundary_matrix(12, nodes, np.array([[0, 1, 2, 3]]), np.array([5.0]),
+                            np.array([1.0]), lumping).toarray()
+        assert k.sum() == pytest.approx(6 * 7.0, rel=1e-12)
+    m = face_matrices(nodes[None], np.array([5.0]), np.array([1.0]), 'lumped')[0]
+    assert np.allclose(m[:3, :3], 1.5 * np.diag([5.0, 1.0, 1.0]))

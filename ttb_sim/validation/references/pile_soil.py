@@ -1,0 +1,141 @@
+# Copyright 2026 The ttb_sim Authors
+#
+# Licensed under the Apache License, Version 2.0 (the "License");
+# you may not use this file except in compliance with the License.
+# You may obtain a copy of the License at
+#
+#     http://www.apache.org/licenses/LICENSE-2.0
+#
+# Unless required by applicable law or agreed to in writing, software
+# distributed under the License is distributed on an "AS IS" BASIS,
+# WITHOUT WARRANTIES OR CONDITIONS OF ANY KIND, either express or implied.
+# See the License for the specific language governing permissions and
+# limitations under the License.
+
+"""
+Closed forms for the pile-soil validation cases V11-V16 (PHYSICS.md 9.4-9.5).
+
+Independent of the finite-element code: the Randolph-Wroth head stiffness of
+a single pile, Gazetas' fit for the same, the modes of a layered shear column
+on a rigid base (exact, from the layer transfer matrices, and the
+quarter-wavelength estimate with the travel-time average Vs), and the
+Clough-Duncan hyperbola with its Mohr-Coulomb cap.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Sequence
+
+import numpy as np
+from scipy.optimize import brentq
+
+
+def randolph_wroth_stiffness(g_l: float, nu: float, length: float, radius: float,
+                             pile_modulus: float, rho: float = 1.0, xi: float = 1.0) -> float:
+    """
+    Return the axial head stiffness of a compressible pile (N/m), Randolph & Wroth (1978).
+
+    Parameters
+    ----------
+    g_l : float
+        Soil shear modulus at the depth of the pile tip (Pa).
+    nu : float
+        Soil Poisson's ratio.
+    length, radius : float
+        Pile length and radius (m).
+    pile_modulus : float
+        Young's modulus of the pile (Pa).
+    rho : float
+        Mean shear modulus over the length over g_l (homogeneity factor).
+    xi : float
+        g_l over the shear modulus below the tip.
+
+    """
+    lam = pile_modulus / g_l
+    zeta = math.log(2.5 * length * rho * (1 - nu) / radius)
+    mu_l = (length / radius) * math.sqrt(2.0 / (zeta * lam))
+    shaft = math.tanh(mu_l) / mu_l * (length / radius)
+    base = 4.0 / ((1 - nu) * xi)
+    ratio = (base + 2 * math.pi * rho / zeta * shaft) / (1 + base * shaft / (math.pi * lam))
+    return ratio * g_l * radius
+
+
+def layered_pile_stiffness(thicknesses: Sequence[float], shear_moduli: Sequence[float],
+                           nu: float, length: float, diameter: float,
+                           pile_modulus: float) -> float:
+    """
+    Return Randolph-Wroth for a pile in horizontal layers (N/m).
+
+    G_L is the modulus of the layer at the tip, rho the length-average of G
+    over G_L, and the soil below the tip is taken as the tip layer (xi = 1).
+    """
+    z = 0.0
+    integral = 0.0
+    g_tip = shear_moduli[-1]
+    for t, g in zip(thicknesses, shear_moduli):
+        inside = max(0.0, min(t, length - z))
+        integral += inside * g
+        if z <= length < z + t:
+            g_tip = g
+        z += t
+    rho = integral / length / g_tip
+    return randolph_wroth_stiffness(g_tip, nu, length, 0.5 * diameter, pile_modulus, rho, 1.0)
+
+
+def gazetas_stiffness(young: float, diameter: float, length: float) -> float:
+    """Return Gazetas' (1991) floating-pile fit K = 1.9 E d (L/d)^(2/3) (N/m)."""
+    return 1.9 * young * diameter * (length / diameter)**(2.0 / 3.0)
+
+
+def quarter_wavelength_frequencies(thicknesses: Sequence[float], vs: Sequence[float],
+                                   n: int) -> np.ndarray:
+    """Return f_k = (2k - 1) Vs_avg / (4 H), k = 1..n, Vs_avg the travel-time average (Hz)."""
+    h = float(sum(thicknesses))
+    vs_avg = h / sum(t / v for t, v in zip(thicknesses, vs))
+    return (2 * np.arange(1, n + 1) - 1) * vs_avg / (4 * h)
+
+
+def shear_column_frequencies(thicknesses: Sequence[float], shear_moduli: Sequence[float],
+                             densities: Sequence[float], n: int) -> np.ndarray:
+    """
+    Return the first n natural frequencies (Hz) of a layered shear column on a rigid base.
+
+    Free surface on top, fixed base; each layer carries u'' = (G / rho) u_zz,
+    solved exactly by layer transfer matrices of (u, tau); the roots of the base
+    displacement are bracketed on a fine frequency grid.
+    """
+    def base_displacement(f: float) -> float:
+        w = 2 * math.pi * f
+        u, tau = 1.0, 0.0
+        for t, g, rho in zip(thicknesses, shear_moduli, densities):
+            k = w * math.sqrt(rho / g)
+            c, s = math.cos(k * t), math.sin(k * t)
+            u, tau = u * c + tau * s / (g * k), -u * g * k * s + tau * c
+        return u
+
+    vs_min = min(math.sqrt(g / r) for g, r in zip(shear_moduli, densities))
+    f_top = (2 * n + 2) * vs_min / (4 * sum(thicknesses))
+    grid = np.linspace(1e-6, f_top, 20000)
+    values = np.array([base_displacement(f) for f in grid])
+    roots = []
+    for i in np.flatnonzero(np.sign(values[:-1]) != np.sign(values[1:])):
+        roots.append(brentq(base_displacement, grid[i], grid[i + 1], xtol=1e-12))
+        if len(roots) == n:
+            break
+    return np.array(roots)
+
+
+def hyperbola_stress(strain: np.ndarray, k0: float, strength: float,
+                     failure_ratio: float) -> np.ndarray:
+    """Return Clough-Duncan tau(g) = g / (1/k0 + R_f g / tau_f), capped at tau_f (Pa)."""
+    g = np.asarray(strain, dtype=float)
+    return np.minimum(g / (1.0 / k0 + failure_ratio * g / strength), strength)
+
+
+def hyperbola_tangent(strain: np.ndarray, k0: float, strength: float,
+                      failure_ratio: float) -> np.ndarray:
+    """Return d tau / d g of the uncapped hyperbola, (1/k0) / (1/k0 + R_f g / tau_f)^2 (Pa)."""
+    g = np.asarray(strain, dtype=float)
+    a = 1.0 / k0
+    return a / (a + failure_ratio * g / strength)**2
