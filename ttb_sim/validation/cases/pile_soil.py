@@ -147,12 +147,14 @@ def v13() -> list[Row]:
 
 
 def single_pile(h: float = 0.443, growth: float = 1.3, h_max: float = 3.0,
-                block: float = 40.0, interface: str = 'desai') -> Substructure:
+                block: float = 40.0, interface: str = 'desai',
+                max_aspect: float = 12.0) -> Substructure:
     """Return the V14 single pile: d = 1.0 m, L = 12 m in the Table 5 soil."""
     return Substructure(soil=SoilBlock(PAPER_LAYERS, lx=block, ly=block),
                         piles=PileGroup(rows=1, cols=1, diameter=1.0, length=12.0),
                         interface=Interface(model=interface),  # type: ignore[arg-type]
-                        mesh=MeshSize(h=h, growth=growth, h_max=h_max),
+                        mesh=MeshSize(h=h, growth=growth, h_max=h_max,
+                                      max_aspect=max_aspect),
                         observation=NO_POINTS)
 
 
@@ -323,7 +325,7 @@ def convergence(sizes: tuple[float, ...] = (0.886 / 2, 0.886 / 3, 0.886 / 4),
     """
     values = []
     for h in sizes:
-        spec = single_pile(h=h, growth=1.3, h_max=2.5, block=30.0)
+        spec = single_pile(h=h, growth=1.3, h_max=2.5, block=30.0, max_aspect=16.0)
         values.append(1.0 / head_stiffness(spec, force))
     r12, r23 = sizes[0] / sizes[1], sizes[1] / sizes[2]
     target = (values[0] - values[1]) / (values[1] - values[2])
