@@ -34,7 +34,7 @@ from dataclasses import dataclass, field
 import math
 from typing import Literal, Optional
 
-from ttb_sim.errors import TtbSimError
+from ttb_sim.errors import ModelError
 
 GRAVITY = 9.81
 #: Side of the square of equal area over the diameter of a circle, sqrt(pi) / 2.
@@ -45,7 +45,7 @@ InterfaceModel = Literal['desai', 'bonded']
 LoadType = Literal['static', 'harmonic', 'pulse']
 
 
-class FoundationError(TtbSimError, ValueError):
+class FoundationError(ModelError):
     """A pile-soil substructure or its load is described by invalid values."""
 
 
