@@ -36,8 +36,8 @@ from typing import Any, Sequence
 from ttb_sim.config.schema import to_plain
 from ttb_sim.errors import ScenarioError
 from ttb_sim.model.bridge import (BearingParameters, BridgeParameters, FoundationParameters,
-                                  PierParameters)
-from ttb_sim.model.track import TrackParameters
+                                  PierParameters, span_frequency)
+from ttb_sim.model.track import track_extent, TrackExtent, TrackParameters
 from ttb_sim.model.vehicle.car import CarParameters
 from ttb_sim.model.wheel_rail.parameters import ContactParameters
 from ttb_sim.parameters import param
@@ -170,15 +170,20 @@ class Scenario:
         """Distances of all axles behind the head (m): ``train.axle_offsets`` or the car layout."""
         if self.train.axle_offsets:
             return tuple(float(a) for a in self.train.axle_offsets)
-        lc, lt = self.car.bogie_semi_spacing, self.car.wheelbase_semi
-        length = self.train.car_length
-        first = length / 2.0 - lc - lt
-        local = (first, first + 2 * lt, first + 2 * lc, first + 2 * lc + 2 * lt)
-        return tuple(k * length + a for k in range(self.train.n_cars) for a in local)
+        return car_layout(self.train, self.car)
 
     def to_dict(self) -> dict[str, Any]:
         """Return the scenario as plain nested dicts (for echo in summaries)."""
         return to_plain(dataclasses.asdict(self))
+
+
+def car_layout(train: TrainConfig, car: CarParameters) -> tuple[float, ...]:
+    """Distances of the axles of ``train.n_cars`` cars behind the head (m), by car geometry."""
+    lc, lt = car.bogie_semi_spacing, car.wheelbase_semi
+    length = train.car_length
+    first = length / 2.0 - lc - lt
+    local = (first, first + 2 * lt, first + 2 * lc, first + 2 * lc + 2 * lt)
+    return tuple(k * length + a for k in range(train.n_cars) for a in local)
 
 
 def _check_consistency(s: Scenario) -> None:
@@ -194,7 +199,74 @@ def _check_consistency(s: Scenario) -> None:
     if s.track.model == 'slab' and s.train.vehicle != 'car':
         raise ScenarioError(f"track.model = 'slab' needs train.vehicle = 'car' (got "
                             f'{s.train.vehicle!r})')
-    parse_observers(s.output.observers)
+    _check_track_fit(s)
+    _check_observers(s)
+
+
+def _bridge_length(s: Scenario) -> float:
+    return s.bridge.n_spans * s.bridge.span_length
+
+
+def _extent(s: Scenario) -> TrackExtent:
+    return track_extent(s.track, _bridge_length(s), s.train.n_cars * s.train.car_length)
+
+
+def _check_track_fit(s: Scenario) -> None:
+    """Refuse a car run whose wheels would start or end off the modelled rails."""
+    if s.train.vehicle != 'car':
+        return
+    ext = _extent(s)
+    offsets = car_layout(s.train, s.car)
+    head = s.train.start_position
+    where = (f'the modelled rails run from x = {ext.rail_start:.2f} to {ext.rail_end:.2f} m '
+             f'(track.approach_length = {s.track.approach_length:g} m'
+             f'{" = automatic" if not s.track.approach_length else ""} before and after the '
+             f'{_bridge_length(s):g} m bridge)')
+    rear, front = head - max(offsets), head - min(offsets)
+    if rear < ext.rail_start or front > ext.rail_end:
+        raise ScenarioError(
+            f'train.start_position = {head:g} m: the axles would start at x = {rear:.2f} .. '
+            f'{front:.2f} m, off the track: {where}; move the train or lengthen '
+            'track.approach_length')
+    speed = s.train.speed
+    f1 = span_frequency(s.bridge.span_length, s.bridge.bending_stiffness,
+                        s.bridge.mass_per_length)
+    if s.solver.duration > 0.0:
+        travel = speed * s.solver.duration
+        key = f'solver.duration = {s.solver.duration:g} s'
+    else:
+        exit_position = _bridge_length(s) + max(offsets)
+        travel = max(exit_position - head, 0.0) + speed * s.solver.free_vibration_periods / f1
+        key = ('solver.duration = 0 (automatic: until the last axle leaves the bridge plus '
+               f'solver.free_vibration_periods = {s.solver.free_vibration_periods:g} periods)')
+    front_end = front + travel
+    if front_end > ext.rail_end:
+        raise ScenarioError(
+            f'{key}: the run is longer than the track: the front axle would reach '
+            f'x = {front_end:.2f} m at {s.train.speed_kmh:g} km/h, but {where}; shorten '
+            'solver.duration or lengthen track.approach_length')
+
+
+def _check_observers(s: Scenario) -> None:
+    """Refuse observers on a component the scenario does not have, or off its extent."""
+    observers = parse_observers(s.output.observers)
+    length = _bridge_length(s)
+    for i, obs in enumerate(observers):
+        where = f'output.observers[{i}] = {obs.name}={obs.component}@{obs.x:g}'
+        if obs.component == 'girder':
+            low, high = 0.0, length
+        elif s.track.model != 'slab':
+            raise ScenarioError(f'{where}: component {obs.component!r} needs '
+                                "track.model = 'slab'")
+        else:
+            ext = _extent(s)
+            if obs.component.startswith('rail'):
+                low, high = ext.rail_start, ext.rail_end
+            else:
+                low, high = ext.unit_start, ext.unit_end
+        if not low <= obs.x <= high:
+            raise ScenarioError(f'{where}: x is not on the {obs.component}, which runs from '
+                                f'{low:g} to {high:g} m')
 
 
 OBSERVER_COMPONENTS = ('rail_left', 'rail_right', 'slab', 'base', 'girder')

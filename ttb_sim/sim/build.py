@@ -22,11 +22,11 @@ out of the scenario once and hands each model builder what it needs.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 
 import numpy as np
 
-from ttb_sim.config import parse_observers, Scenario
+from ttb_sim.config import car_layout, parse_observers, Scenario
 from ttb_sim.errors import ScenarioError
 from ttb_sim.model.bridge import assemble_structure, Structure
 from ttb_sim.model.irregularity import load_csv, synthesize, TrackIrregularity
@@ -63,7 +63,7 @@ def build_vehicle(scenario: Scenario) -> Vehicle:
     axles = Axles(offsets=np.asarray(scenario.axle_positions(), dtype=float))
     n = axles.count
     if train.vehicle == 'car':
-        layout = replace(scenario, train=replace(train, axle_offsets=())).axle_positions()
+        layout = car_layout(train, scenario.car)
         return MultibodyCars(axles=Axles(offsets=np.asarray(layout, dtype=float)),
                              n_cars=train.n_cars, car_length=train.car_length)
     if train.vehicle == 'moving_force':
