@@ -101,5 +101,5 @@ def test_observers_off_their_component_are_refused_before_building(entry: str,
 
 @pytest.mark.parametrize('entry', ['a=rail_left@-45', 'a=base@80', 'a=slab@1e4'])
 def test_track_observers_off_the_track_are_refused(entry: str) -> None:
-    with pytest.raises(ScenarioError, match=r'output.observers\[0\] = a=.*x is not on the'):
+    with pytest.raises(ScenarioError, match=r"output.observers\[0\] = 'a=.*x is not on the"):
         load_scenario('track_approach', values=[('output.observers', [entry])])

@@ -35,6 +35,7 @@ from typing import Any, Sequence
 
 from ttb_sim.config.schema import to_plain
 from ttb_sim.errors import ScenarioError
+from ttb_sim.inputs import shown
 from ttb_sim.model.bridge import (BearingParameters, BridgeParameters, FoundationParameters,
                                   PierParameters, span_frequency)
 from ttb_sim.model.track import track_extent, TrackExtent, TrackParameters
@@ -252,7 +253,7 @@ def _check_observers(s: Scenario) -> None:
     observers = parse_observers(s.output.observers)
     length = _bridge_length(s)
     for i, obs in enumerate(observers):
-        where = f'output.observers[{i}] = {obs.name}={obs.component}@{obs.x:g}'
+        where = f'output.observers[{i}] = {shown(s.output.observers[i])}'
         if obs.component == 'girder':
             low, high = 0.0, length
         elif s.track.model != 'slab':
@@ -295,22 +296,22 @@ def parse_observers(entries: Sequence[str]) -> tuple[Observer, ...]:
     """
     out: list[Observer] = []
     for i, entry in enumerate(entries):
-        path = f'output.observers[{i}] = {entry!r}'
+        path = f'output.observers[{i}] = {shown(entry)}'
         match = _OBSERVER.match(entry.strip())
         if not match:
             raise ScenarioError(f"{path}: expected 'name=component@x' with a name of "
                                 'letters, digits and _ (starting with a letter)')
         name, component, x_text = match.groups()
         if component not in OBSERVER_COMPONENTS:
-            raise ScenarioError(f'{path}: component {component!r} is unknown; allowed: '
+            raise ScenarioError(f'{path}: component {shown(component)} is unknown; allowed: '
                                 f'{", ".join(OBSERVER_COMPONENTS)}')
         try:
             x = float(x_text)
         except ValueError:
             x = math.nan
         if not math.isfinite(x):
-            raise ScenarioError(f'{path}: position {x_text!r} is not a finite number (m)')
+            raise ScenarioError(f'{path}: position {shown(x_text)} is not a finite number (m)')
         if any(o.name == name for o in out):
-            raise ScenarioError(f'{path}: observer name {name!r} is used twice')
+            raise ScenarioError(f'{path}: observer name {shown(name)} is used twice')
         out.append(Observer(name, component, x))
     return tuple(out)

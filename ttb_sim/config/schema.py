@@ -29,6 +29,7 @@ import sys
 from typing import Any, Iterator, Mapping
 
 from ttb_sim.errors import ModelError, ScenarioError
+from ttb_sim.inputs import shown
 from ttb_sim.parameters import Spec
 
 __all__ = ['from_mapping', 'iter_keys', 'key_spec', 'MOVED_KEYS', 'to_plain']
@@ -38,6 +39,9 @@ MOVED_KEYS = {
     'train.wheelbase_semi': 'car.wheelbase_semi',
 }
 """Keys that moved to another section (old path -> new path), refused with a pointer."""
+
+MAX_LIST_ITEMS = 1000
+"""Most entries of a list-valued key (axle offsets, observers)."""
 
 
 def _moved(path: str) -> str:
@@ -83,7 +87,7 @@ def key_spec(path: str) -> tuple[type, Any, Spec]:
     for key, typ, default, spec in iter_keys():
         if key == path:
             return typ, default, spec
-    raise ScenarioError(f'unknown key {path!r}{_moved(path)}; see `ttb-sim scenarios --keys` '
+    raise ScenarioError(f'unknown key {shown(path)}{_moved(path)}; see `ttb-sim scenarios --keys` '
                         'for the list')
 
 
@@ -122,7 +126,7 @@ def from_mapping(data: Mapping[str, Any], cls: type | None = None, prefix: str =
     cls = _root(cls)
     if not isinstance(data, Mapping):
         where = prefix[:-1] or 'the scenario'
-        raise ScenarioError(f'{where} must be a mapping of keys, got {data!r}')
+        raise ScenarioError(f'{where} must be a mapping of keys, got {shown(data)}')
     hints = _hints(cls)
     names = {f.name: f for f in dataclasses.fields(cls)}
     kwargs: dict[str, Any] = {}
@@ -130,7 +134,8 @@ def from_mapping(data: Mapping[str, Any], cls: type | None = None, prefix: str =
         path = f'{prefix}{key}'
         if key not in names:
             allowed = ', '.join(sorted(names))
-            raise ScenarioError(f'unknown key {path!r}{_moved(path)}; allowed here: {allowed}')
+            raise ScenarioError(f'unknown key {shown(path)}{_moved(path)}; allowed here: '
+                                f'{allowed}')
         f = names[key]
         if 'spec' in f.metadata:
             kwargs[key] = _coerce(path, value, hints[key], f.metadata['spec'])
@@ -148,25 +153,29 @@ def from_mapping(data: Mapping[str, Any], cls: type | None = None, prefix: str =
 
 def _coerce(path: str, value: Any, typ: Any, spec: Spec) -> Any:
     """Check one value against its declared type and range, and return it typed."""
+    if isinstance(value, (list, tuple)) and len(value) > MAX_LIST_ITEMS:
+        raise ScenarioError(f'{path} = {shown(value)}: too many entries; at most '
+                            f'{MAX_LIST_ITEMS}')
     if typ in (tuple[float, ...],):
         if not isinstance(value, (list, tuple)):
-            raise ScenarioError(f'{path} = {value!r}: expected a list of numbers ({spec.unit})')
+            raise ScenarioError(f'{path} = {shown(value)}: expected a list of numbers '
+                                f'({spec.unit})')
         items = tuple(_coerce_number(f'{path}[{i}]', v, float, spec)
                       for i, v in enumerate(value))
         return items
     if typ in (tuple[str, ...],):
         if not isinstance(value, (list, tuple)) or not all(isinstance(v, str) for v in value):
-            raise ScenarioError(f'{path} = {value!r}: expected a list of strings')
+            raise ScenarioError(f'{path} = {shown(value)}: expected a list of strings')
         return tuple(value)
     if typ is bool:
         if not isinstance(value, bool):
-            raise ScenarioError(f'{path} = {value!r}: expected true or false')
+            raise ScenarioError(f'{path} = {shown(value)}: expected true or false')
         return value
     if typ is str:
         if not isinstance(value, str):
-            raise ScenarioError(f'{path} = {value!r}: expected a string, {spec.allowed()}')
+            raise ScenarioError(f'{path} = {shown(value)}: expected a string, {spec.allowed()}')
         if spec.choices is not None and value not in spec.choices:
-            raise ScenarioError(f'{path} = {value!r}: allowed values are {spec.allowed()}')
+            raise ScenarioError(f'{path} = {shown(value)}: allowed values are {spec.allowed()}')
         return value
     if typ in (float, int):
         return _coerce_number(path, value, typ, spec)
@@ -176,20 +185,20 @@ def _coerce(path: str, value: Any, typ: Any, spec: Spec) -> Any:
 def _coerce_number(path: str, value: Any, typ: type, spec: Spec) -> float | int:
     if isinstance(value, bool) or not isinstance(value, (int, float)):
         kind = 'an integer' if typ is int else 'a number'
-        raise ScenarioError(f'{path} = {value!r}: expected {kind}, allowed {spec.allowed()}')
+        raise ScenarioError(f'{path} = {shown(value)}: expected {kind}, allowed {spec.allowed()}')
     if typ is int:
         if isinstance(value, float):
             if not value.is_integer():
-                raise ScenarioError(f'{path} = {value!r}: expected an integer, allowed '
+                raise ScenarioError(f'{path} = {shown(value)}: expected an integer, allowed '
                                     f'{spec.allowed()}')
         value = int(value)
     else:
         value = float(value)
         if not math.isfinite(value):
-            raise ScenarioError(f'{path} = {value!r}: expected a finite number, allowed '
+            raise ScenarioError(f'{path} = {shown(value)}: expected a finite number, allowed '
                                 f'{spec.allowed()}')
     if not spec.contains(value):
-        raise ScenarioError(f'{path} = {value!r} is out of range: allowed {spec.allowed()}')
+        raise ScenarioError(f'{path} = {shown(value)} is out of range: allowed {spec.allowed()}')
     return value
 
 

@@ -25,6 +25,7 @@ from rosbags.rosbag2 import StoragePlugin, Writer
 from rosbags.rosbag2.errors import WriterError
 from rosbags.typesys import get_typestore, Stores
 from ttb_sim.errors import ScenarioError
+from ttb_sim.inputs import shown
 from ttb_sim.io.topics import NAMESPACE, Topic
 from ttb_sim.sim.frames import Frame
 
@@ -43,10 +44,10 @@ def check_destination(path: str | Path, storage: str) -> None:
 
     """
     if storage not in STORAGES:
-        raise ScenarioError(f'storage {storage!r}: allowed values are {", ".join(STORAGES)}')
+        raise ScenarioError(f'storage {shown(storage)}: allowed values are {", ".join(STORAGES)}')
     if Path(path).exists():
-        raise ScenarioError(f'output directory {str(path)!r} exists; refusing to overwrite it '
-                            '(choose another --out)')
+        raise ScenarioError(f'output directory {shown(str(path))} exists; refusing to '
+                            'overwrite it (choose another --out)')
 
 
 def default_bag_path(name: str, root: Path = Path('runs')) -> Path:
@@ -125,7 +126,7 @@ class BagRecorder:
         try:
             self._writer.open()
         except WriterError as exc:
-            raise ScenarioError(f'cannot create bag {str(self.path)!r}: {exc}') from None
+            raise ScenarioError(f'cannot create bag {shown(str(self.path))}: {exc}') from None
         self._open = True
         self._connections = [
             self._writer.add_connection(t.full_name(self._namespace), t.msgtype,

@@ -28,6 +28,7 @@ import numpy as np
 
 from ttb_sim.config import car_layout, parse_observers, Scenario
 from ttb_sim.errors import ScenarioError
+from ttb_sim.inputs import shown
 from ttb_sim.model.bridge import assemble_structure, Structure
 from ttb_sim.model.irregularity import load_csv, synthesize, TrackIrregularity
 from ttb_sim.model.vehicle.train import Axles, MovingForces, MultibodyCars, QuarterCars, Vehicle
@@ -157,7 +158,7 @@ def observer_rows(scenario: Scenario, structure: Structure) -> tuple[np.ndarray,
     ftf = structure.full_to_free
     track = structure.track
     for i, obs in enumerate(observers):
-        where = f'output.observers[{i}] = {obs.name}={obs.component}@{obs.x:g}'
+        where = f'output.observers[{i}] = {shown(scenario.output.observers[i])}'
         if obs.component == 'girder':
             line = structure.girder_beam
         elif track is None:

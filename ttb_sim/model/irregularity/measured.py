@@ -29,17 +29,19 @@ import logging
 import math
 import operator
 from os import PathLike
-from pathlib import Path
 
 import numpy as np
 from scipy.interpolate import CubicSpline
 
 from ttb_sim.errors import ScenarioError
+from ttb_sim.inputs import MAX_SHOWN, read_user_file, shown
 from ttb_sim.model.irregularity._checks import check_positive, GRID_SLACK
 from ttb_sim.model.irregularity.profile import RAIL_QUANTITIES, TrackIrregularity
 
 __all__ = [
     'CSV_COLUMNS',
+    'MAX_CSV_BYTES',
+    'MAX_GRID_POINTS',
     'MIN_CSV_ROWS',
     'load_csv',
     'save_csv',
@@ -52,6 +54,12 @@ CSV_COLUMNS: tuple[str, ...] = ('x', *RAIL_QUANTITIES)
 
 #: Fewest data rows accepted from a CSV (a cubic spline needs four).
 MIN_CSV_ROWS: int = 4
+
+#: Largest irregularity CSV read (bytes): 3 km at 1 cm is about 20 MB.
+MAX_CSV_BYTES: int = 64 << 20
+
+#: Most points of a resampled profile (10 km at 1 mm).
+MAX_GRID_POINTS: int = 10_000_000
 
 
 def save_csv(irregularity: TrackIrregularity, path: str | PathLike[str]) -> None:
@@ -80,7 +88,8 @@ def save_csv(irregularity: TrackIrregularity, path: str | PathLike[str]) -> None
 
 
 def _refuse(path: str | PathLike[str], row: int | None, problem: str) -> ScenarioError:
-    where = f'{path}' if row is None else f'{path}: row {row}'
+    name = shown(str(path)) if len(str(path)) > MAX_SHOWN else str(path)
+    where = name if row is None else f'{name}: row {row}'
     return ScenarioError(f'{where}: {problem}')
 
 
@@ -133,10 +142,7 @@ def load_csv(
         If ``dx`` is given and is not a finite number > 0.
 
     """
-    try:
-        text = Path(path).read_text(encoding='utf-8-sig')
-    except (OSError, UnicodeDecodeError) as exc:
-        raise _refuse(path, None, f'cannot read irregularity file ({exc})') from None
+    text = read_user_file(path, 'irregularity file', MAX_CSV_BYTES, encoding='utf-8-sig')
     lines = text.splitlines()
     rows = list(csv.reader(lines))
     if len(rows) != len(lines):   # a quoted field spanning lines
@@ -152,7 +158,7 @@ def load_csv(
     if missing:
         message = (
             f'header is missing column(s) {", ".join(missing)}; '
-            f'expected {", ".join(CSV_COLUMNS)}, found {", ".join(header)}')
+            f'expected {", ".join(CSV_COLUMNS)}, found {shown(", ".join(header))}')
         raise _refuse(path, header_index + 1, message)
     duplicated = sorted({name for name in CSV_COLUMNS if header.count(name) > 1})
     if duplicated:
@@ -180,17 +186,19 @@ def load_csv(
     except ValueError:
         parsed = np.asarray(np.frompyfunc(_parses_as_float, 1, 1)(cells)).astype(bool)
         r, c = np.argwhere(~parsed)[0]
-        message = f'non-numeric value {str(cells[r, c])!r} in column {CSV_COLUMNS[c]}'
+        message = f'non-numeric value {shown(str(cells[r, c]))} in column {CSV_COLUMNS[c]}'
         raise _refuse(path, int(row_numbers[r]), message) from None
     bad = np.argwhere(~np.isfinite(numbers))
     if bad.size:
         r, c = bad[0]
-        message = f'value {str(cells[r, c])!r} in column {CSV_COLUMNS[c]} is not a finite number'
+        message = (f'value {shown(str(cells[r, c]))} in column {CSV_COLUMNS[c]} is not a finite '
+                   'number')
         raise _refuse(path, int(row_numbers[r]), message)
 
     x = numbers[:, 0]
     rails = numbers[:, 1:].T
-    steps = np.diff(x)
+    with np.errstate(over='ignore', invalid='ignore'):  # a span over 1.8e308 m: refused below
+        steps = np.diff(x)
     decreasing = np.flatnonzero(steps <= 0.0)
     if decreasing.size:
         r = decreasing[0] + 1
@@ -198,7 +206,8 @@ def load_csv(
             f'x = {x[r]:g} m does not increase strictly (previous data row {row_numbers[r - 1]} '
             f'has x = {x[r - 1]:g} m)')
         raise _refuse(path, int(row_numbers[r]), message)
-    covered = x[-1] - x[0]
+    with np.errstate(over='ignore'):
+        covered = float(x[-1] - x[0])
     if min_length is not None and covered < float(min_length) * (1.0 - GRID_SLACK):
         message = (
             f'profile too short: it covers {covered:g} m (x = {x[0]:g} to {x[-1]:g} m, last '
@@ -206,6 +215,9 @@ def load_csv(
         raise _refuse(path, int(row_numbers[-1]), message)
 
     spacing = float(np.median(steps))
+    if not (math.isfinite(covered) and spacing > 0.0 and math.isfinite(spacing)):
+        raise _refuse(path, None, f'x spans {covered:g} m with a median spacing of {spacing:g} m; '
+                      'both must be finite and > 0')
     uniform = bool(np.max(np.abs(steps - spacing)) <= 1e-6 * spacing)
     spline = CubicSpline(x, rails, axis=1)
     if dx is None and uniform:
@@ -214,6 +226,12 @@ def load_csv(
         grid = x
     else:
         grid_dx = spacing if dx is None else check_positive('dx', dx)
+        n_grid = covered / grid_dx
+        if n_grid > MAX_GRID_POINTS:
+            raise _refuse(path, None, f'resampling {covered:g} m at dx = {grid_dx:g} m (the '
+                          f'{"median row spacing" if dx is None else "grid spacing"}) gives '
+                          f'{n_grid:.3g} points, over the limit of {MAX_GRID_POINTS}; give '
+                          'uniformly spaced rows or fewer, wider-spaced ones')
         grid = x[0] + grid_dx * np.arange(int(math.floor(covered / grid_dx + GRID_SLACK)) + 1)
         if grid.size < 2:
             raise _refuse(path, None, f'dx = {grid_dx:g} m is longer than the profile')
