@@ -26,8 +26,11 @@ from __future__ import annotations
 
 import argparse
 import logging
+import os
 from pathlib import Path
+import signal
 import sys
+import threading
 from typing import Sequence
 
 from ttb_sim import __version__
@@ -35,7 +38,7 @@ from ttb_sim.errors import ModelError, ScenarioError, TtbSimError
 
 log = logging.getLogger('ttb_sim')
 
-EXIT_OK, EXIT_FAILURE, EXIT_USAGE = 0, 1, 2
+EXIT_OK, EXIT_FAILURE, EXIT_USAGE, EXIT_INTERRUPTED = 0, 1, 2, 130
 
 
 def _parser() -> argparse.ArgumentParser:
@@ -83,8 +86,26 @@ def _parser() -> argparse.ArgumentParser:
     return p
 
 
+def _stop_now(signum: int, frame: object) -> None:
+    """Before a verb takes over the signals nothing is written: end at once, one line."""
+    name = 'SIGTERM' if signum == signal.SIGTERM else 'SIGINT'
+    os.write(2, f'ttb-sim: stopped by {name}\n'.encode())
+    os._exit(128 + signum)
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Run the command line; return the exit code."""
+    previous = {}
+    if threading.current_thread() is threading.main_thread():
+        previous = {sig: signal.signal(sig, _stop_now) for sig in (signal.SIGINT, signal.SIGTERM)}
+    try:
+        return _main(argv)
+    finally:
+        for sig, handler in previous.items():
+            signal.signal(sig, handler)
+
+
+def _main(argv: Sequence[str] | None) -> int:
     parser = _parser()
     args = parser.parse_args(argv)
     logging.basicConfig(level=logging.INFO if args.verbose else logging.WARNING,
@@ -112,6 +133,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     except TtbSimError as exc:
         print(f'ttb-sim: failed: {exc}', file=sys.stderr)
         return EXIT_FAILURE
+    except KeyboardInterrupt:  # before a verb installed its own handler
+        print('ttb-sim: stopped by SIGINT', file=sys.stderr)
+        return EXIT_INTERRUPTED
 
 
 if __name__ == '__main__':  # pragma: no cover
