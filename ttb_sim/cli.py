@@ -59,6 +59,8 @@ def _parser() -> argparse.ArgumentParser:
     run.add_argument('--set', dest='overrides', action='append', default=[],
                      metavar='KEY=VALUE', help='override a scenario key (YAML scalar); '
                      'repeatable')
+    run.add_argument('--force', action='store_true', help='run even when the plan exceeds '
+                     'the step budget (2e7 time steps)')
 
     val = sub.add_parser('validate', help='run the validation suite and print a table')
     val.add_argument('cases', nargs='*', metavar='CASE', help='case ids (default: all)')
@@ -115,7 +117,7 @@ def _main(argv: Sequence[str] | None) -> int:
             from ttb_sim.commands.run import run
             return run(args.scenario, out=args.out, storage=args.storage,
                        overrides=args.overrides, speed_kmh=args.speed_kmh,
-                       duration=args.duration)
+                       duration=args.duration, force=args.force)
         if args.command == 'validate':
             from ttb_sim.commands.validate import validate
             return validate(args.cases, list_only=args.list)
@@ -133,6 +135,9 @@ def _main(argv: Sequence[str] | None) -> int:
     except TtbSimError as exc:
         print(f'ttb-sim: failed: {exc}', file=sys.stderr)
         return EXIT_FAILURE
+    except BrokenPipeError:  # stdout closed early (`ttb-sim scenarios | head`): not an error
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        return EXIT_OK
     except KeyboardInterrupt:  # before a verb installed its own handler
         print('ttb-sim: stopped by SIGINT', file=sys.stderr)
         return EXIT_INTERRUPTED

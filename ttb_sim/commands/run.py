@@ -37,6 +37,8 @@ from ttb_sim.config import load_scenario, Scenario
 from ttb_sim.errors import DivergenceError
 from ttb_sim.io.bag import BagRecorder, check_destination, default_bag_path, make_parents
 from ttb_sim.io.topics import PeakTracker, topic_table
+from ttb_sim.model.vehicle.train import MultibodyCars
+from ttb_sim.sim.cost import CostEstimate, estimate_cost, STEP_BUDGET
 from ttb_sim.sim.simulation import Simulation
 
 log = logging.getLogger(__name__)
@@ -97,7 +99,7 @@ def run_to_bag(scenario: Scenario, out: Path, storage: str = 'mcap',
                progress: Callable[[int], None] | None = None,
                simulation: Simulation | None = None,
                should_stop: Callable[[], bool] | None = None,
-               setup_time: float = 0.0) -> RunResult:
+               setup_time: float = 0.0, estimate: CostEstimate | None = None) -> RunResult:
     """
     Simulate a scenario and record it.
 
@@ -120,6 +122,9 @@ def run_to_bag(scenario: Scenario, out: Path, storage: str = 'mcap',
     setup_time : float
         Seconds already spent on set-up (loading, building) by the caller; the
         time to build ``simulation`` here, when it is not given, is added.
+    estimate : CostEstimate, optional
+        The cost estimate told to the user (made here when not given); it is
+        written to ``summary.json``.
 
     Returns
     -------
@@ -140,6 +145,7 @@ def run_to_bag(scenario: Scenario, out: Path, storage: str = 'mcap',
     sim = simulation or Simulation(scenario)
     setup_time += time.perf_counter() - built
     topics = topic_table(sim.layout)
+    estimate = estimate or plan_cost(sim, len(topics))
     peaks = PeakTracker(topics)
     make_parents(out)
     status, message, frames, last_time = 'ok', '', 0, 0.0
@@ -176,6 +182,7 @@ def run_to_bag(scenario: Scenario, out: Path, storage: str = 'mcap',
                        'output_every_steps': sim.output_every},
             'frames': frames,
             'simulated_time': last_time,
+            'estimate': estimate.as_dict(),
             'setup_time': setup_time,
             'stepping_time': stepping,
             'wall_time': wall,
@@ -188,9 +195,17 @@ def run_to_bag(scenario: Scenario, out: Path, storage: str = 'mcap',
     return RunResult(path=out, status=status, summary=summary)
 
 
+def plan_cost(sim: Simulation, messages_per_frame: int) -> CostEstimate:
+    """Return the cost estimate of a built simulation (before it runs)."""
+    cars = sim.vehicle.n_cars if isinstance(sim.vehicle, MultibodyCars) else 0
+    return estimate_cost(steps=sim.n_steps, dt=sim.dt, free_dofs=sim.structure.n_free,
+                         cars=cars, frames=sim.n_frames, messages_per_frame=messages_per_frame,
+                         variant=sim.scenario.solver.variant)
+
+
 def run(scenario: str | Path, *, out: Path | None = None, storage: str = 'mcap',
         overrides: Sequence[str] = (), speed_kmh: float | None = None,
-        duration: float | None = None) -> int:
+        duration: float | None = None, force: bool = False) -> int:
     """
     Run ``ttb-sim run``: load, build, simulate to a bag; return the exit code.
 
@@ -206,11 +221,14 @@ def run(scenario: str | Path, *, out: Path | None = None, storage: str = 'mcap',
         ``KEY=VALUE`` strings (YAML scalars).
     speed_kmh, duration
         Shortcuts for ``train.speed_kmh`` and ``solver.duration``.
+    force
+        Run even above the step budget (:data:`~ttb_sim.sim.cost.STEP_BUDGET`).
 
     Raises
     ------
     ScenarioError
-        Before anything is written, for a bad scenario or destination.
+        Before anything is written, for a bad scenario or destination, or a
+        plan over the step budget without ``force``.
 
     """
     start = time.perf_counter()
@@ -219,7 +237,9 @@ def run(scenario: str | Path, *, out: Path | None = None, storage: str = 'mcap',
     bar = None
     try:
         loaded, out, simulation = _set_up(scenario, out, storage, overrides, speed_kmh,
-                                          duration)
+                                          duration, force)
+        estimate = plan_cost(simulation, len(topic_table(simulation.layout)))
+        print(f'ttb-sim: plan: {estimate.describe()}', file=sys.stderr)
         stop.setup = False  # from here on a signal closes the bag cleanly
         if sys.stderr.isatty():
             from tqdm import tqdm
@@ -228,7 +248,7 @@ def run(scenario: str | Path, *, out: Path | None = None, storage: str = 'mcap',
         result = run_to_bag(loaded, out, storage,
                             progress=bar.update if bar is not None else None,
                             simulation=simulation, should_stop=stop.__bool__,
-                            setup_time=time.perf_counter() - start)
+                            setup_time=time.perf_counter() - start, estimate=estimate)
     finally:
         for sig, handler in previous.items():
             signal.signal(sig, handler)
@@ -250,7 +270,7 @@ def run(scenario: str | Path, *, out: Path | None = None, storage: str = 'mcap',
 
 
 def _set_up(scenario: str | Path, out: Path | None, storage: str, overrides: Sequence[str],
-            speed_kmh: float | None, duration: float | None
+            speed_kmh: float | None, duration: float | None, force: bool
             ) -> tuple[Scenario, Path, Simulation]:
     """Load the scenario, check the destination, then build the model (in that order)."""
     values: list[tuple[str, Any]] = []
@@ -262,4 +282,4 @@ def _set_up(scenario: str | Path, out: Path | None, storage: str, overrides: Seq
     out = Path(out) if out is not None else default_bag_path(loaded.name)
     check_destination(out, storage)  # before the model is built: a bad --out fails at once
     log.info('set-up: building the model of %s', loaded.name)
-    return loaded, out, Simulation(loaded)
+    return loaded, out, Simulation(loaded, max_steps=None if force else STEP_BUDGET)
