@@ -101,9 +101,11 @@ class IrregularityConfig:
                       high=2**31 - 1, dynamic=True)
     scale: float = param(1.0, '-', 'Factor on the irregularity amplitude; 0 gives a smooth '
                          'track.', low=0.0, high=100.0, dynamic=True)
-    file: str = param('', '-', 'CSV of a measured profile (x, z_left, z_right, y_left, '
-                      'y_right in metres; smooth outside its range); empty = synthesise '
-                      'from the spectrum.', dynamic=True)
+    file: str = param('', '-', 'CSV of a measured profile in metres: a header row naming '
+                      'x, z_left, z_right, y_left, y_right (any order; other columns are '
+                      'ignored), or no header and exactly these five numeric columns in this '
+                      'order; a regular file of at most 64 MiB; smooth outside its range. '
+                      'Empty = synthesise from the spectrum.', dynamic=True)
     grid_spacing: float = param(0.01, 'm', 'Grid spacing of the synthesised profile (must be '
                                 'under half the shortest wavelength).', low=0.001, high=1.0)
 

@@ -17,7 +17,8 @@ Measured rail irregularity profiles: CSV read (:func:`load_csv`) and write.
 
 The file has a header row naming at least :data:`CSV_COLUMNS` (x along the
 track, then the rail irregularities with the signs of :mod:`.profile`), one
-row per position.  A refused user file raises
+row per position; a file without a header must have exactly those five
+numeric columns, in that order.  A refused user file raises
 :class:`~ttb_sim.errors.ScenarioError` naming the file and the row; a bad
 argument (``dx``) raises :class:`~ttb_sim.errors.ModelError`.
 """
@@ -57,6 +58,9 @@ MIN_CSV_ROWS: int = 4
 
 #: Largest irregularity CSV read (bytes): 3 km at 1 cm is about 20 MB.
 MAX_CSV_BYTES: int = 64 << 20
+
+#: Longest numeric cell read (characters); longer ones are refused as non-numeric.
+MAX_CELL_CHARS: int = 100
 
 #: Most points of a resampled profile (10 km at 1 mm).
 MAX_GRID_POINTS: int = 10_000_000
@@ -104,8 +108,10 @@ def load_csv(
 
     The file has a header row naming at least the columns ``x, z_left,
     z_right, y_left, y_right`` (any order; other columns are ignored), then one
-    row per position: x along the track (m, strictly increasing) and the rail
-    irregularities (m, signs as in :mod:`.profile`).  Blank lines and
+    row per position; or no header, when its first row is all numbers, and then
+    exactly these five columns in this order. Each row holds x along the
+    track (m, strictly increasing) and the rail irregularities (m, signs as
+    in :mod:`.profile`).  Blank lines and
     lines starting with ``#`` are skipped.  Row numbers in messages are line
     numbers of the file, counting from 1 (the header is usually row 1).
 
@@ -144,27 +150,42 @@ def load_csv(
     """
     text = read_user_file(path, 'irregularity file', MAX_CSV_BYTES, encoding='utf-8-sig')
     lines = text.splitlines()
-    rows = list(csv.reader(lines))
+    try:
+        rows = list(csv.reader(lines))
+    except csv.Error as exc:  # e.g. a field over the csv module's size limit
+        raise _refuse(path, None, f'cannot parse as CSV ({shown(str(exc))[1:-1]})') from None
     if len(rows) != len(lines):   # a quoted field spanning lines
         raise _refuse(path, None, 'unbalanced quotes; cannot parse as CSV')
-    stripped = np.char.strip(np.array(lines, dtype=str)) if lines else np.array([], dtype=str)
-    content = np.flatnonzero((stripped != '') & ~np.char.startswith(stripped, '#'))
+    content = np.array([i for i, line in enumerate(lines)
+                        if line.strip() and not line.strip().startswith('#')], dtype=np.intp)
     if content.size == 0:
-        raise _refuse(path, 1, f'no header; expected columns {", ".join(CSV_COLUMNS)}')
+        raise _refuse(path, 1, f'no header and no data rows; expected a header row naming '
+                      f'the columns {", ".join(CSV_COLUMNS)} (or no header and exactly five '
+                      'numeric columns in that order)')
 
     header_index = int(content[0])
     header = [name.strip() for name in rows[header_index]]
-    missing = [name for name in CSV_COLUMNS if name not in header]
-    if missing:
-        message = (
-            f'header is missing column(s) {", ".join(missing)}; '
-            f'expected {", ".join(CSV_COLUMNS)}, found {shown(", ".join(header))}')
-        raise _refuse(path, header_index + 1, message)
-    duplicated = sorted({name for name in CSV_COLUMNS if header.count(name) > 1})
-    if duplicated:
-        raise _refuse(path, header_index + 1, f'duplicated column(s) {", ".join(duplicated)}')
-
-    data_index = content[1:]
+    if header and all(_parses_as_float(name) for name in header):  # no header: numbers
+        if len(header) != len(CSV_COLUMNS):
+            message = (f'the first row is numbers, so the file has no header: a headerless '
+                       f'file needs exactly {len(CSV_COLUMNS)} columns '
+                       f'({", ".join(CSV_COLUMNS)}, in that order), found {len(header)}; '
+                       'or add a header row naming the columns')
+            raise _refuse(path, header_index + 1, message)
+        header = list(CSV_COLUMNS)
+        data_index = content
+    else:
+        missing = [name for name in CSV_COLUMNS if name not in header]
+        if missing:
+            message = (
+                f'header is missing column(s) {", ".join(missing)}; '
+                f'expected {", ".join(CSV_COLUMNS)}, found {shown(", ".join(header))}')
+            raise _refuse(path, header_index + 1, message)
+        duplicated = sorted({name for name in CSV_COLUMNS if header.count(name) > 1})
+        if duplicated:
+            raise _refuse(path, header_index + 1,
+                          f'duplicated column(s) {", ".join(duplicated)}')
+        data_index = content[1:]
     row_numbers = data_index + 1
     if data_index.size < MIN_CSV_ROWS:
         last = f'last data row {row_numbers[-1]}' if data_index.size else 'no data rows'
@@ -179,8 +200,15 @@ def load_csv(
         r = wrong[0]
         message = f'expected {len(header)} fields as in the header, found {widths[r]}'
         raise _refuse(path, int(row_numbers[r]), message)
-    table = np.array(operator.itemgetter(*data_index)(rows), dtype=str)
-    cells = np.char.strip(table[:, [header.index(name) for name in CSV_COLUMNS]])
+    columns = [header.index(name) for name in CSV_COLUMNS]
+    data_rows = operator.itemgetter(*data_index)(rows)
+    selected = [[row[j].strip() for j in columns] for row in data_rows]
+    for r, row_cells in enumerate(selected):  # bound the fixed-width array below
+        for c, cell in enumerate(row_cells):
+            if len(cell) > MAX_CELL_CHARS:
+                message = f'non-numeric value {shown(cell)} in column {CSV_COLUMNS[c]}'
+                raise _refuse(path, int(row_numbers[r]), message)
+    cells = np.array(selected, dtype=str)
     try:
         numbers = cells.astype(np.float64)
     except ValueError:
