@@ -112,6 +112,9 @@ def test_yaml_errors_name_the_file(tmp_path, capsys):
 @pytest.mark.parametrize('text, words', [
     ('a: ' + '1' * 5000, 'a value cannot be read'),
     ('a: 2001-13-45', 'a value cannot be read'),
+    ('!!float ', 'a value cannot be read'),
+    ('a: !!float', 'a value cannot be read'),
+    ('a: !!int', 'a value cannot be read'),
     ('a: !!python/name:os.system', 'could not determine a constructor'),
 ])
 def test_values_yaml_cannot_construct_are_refused(tmp_path, text, words):

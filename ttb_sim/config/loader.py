@@ -100,15 +100,17 @@ def read_yaml(text: str, name: str = '<text>') -> Any:
     yaml.YAMLError
         For invalid YAML, anchors or aliases, or nesting deeper than
         :data:`MAX_YAML_DEPTH`; also for a value YAML cannot construct (a
-        timestamp such as 2001-13-45, an integer of over 4300 digits), which
-        PyYAML reports as ValueError.
+        timestamp such as 2001-13-45, an integer of over 4300 digits, an empty
+        ``!!float``), which PyYAML reports as ValueError or IndexError.
 
     """
     loader = YamlLoader(text)
     loader.name = name
     try:
         return loader.get_single_data()
-    except ValueError as exc:  # a scalar PyYAML's constructors refuse
+    except (ValueError, IndexError, TypeError, OverflowError) as exc:
+        # A scalar PyYAML's constructors fail on: an over-long integer or a bad timestamp
+        # (ValueError), an empty '!!float' (IndexError).
         raise yaml.YAMLError(f'a value cannot be read ({shown(str(exc))})') from None
     except RecursionError:  # pragma: no cover - the depth bound comes first
         raise yaml.YAMLError('nesting too deep') from None

@@ -202,8 +202,44 @@ def _check_consistency(s: Scenario) -> None:
     if s.track.model == 'slab' and s.train.vehicle != 'car':
         raise ScenarioError(f"track.model = 'slab' needs train.vehicle = 'car' (got "
                             f'{s.train.vehicle!r})')
+    _check_model_size(s)
     _check_track_fit(s)
     _check_observers(s)
+
+
+MAX_MODEL_NODES = 200_000
+"""Most finite-element nodes a scenario may ask for (about 1.2 million DOFs; paper_ttbi: 8 000)."""
+
+
+def model_nodes(s: Scenario) -> int:
+    """Count the beam nodes the model of a scenario will have, before building it."""
+    nodes = s.bridge.n_spans * (s.bridge.elements_per_span + 1)
+    if s.bridge.n_spans > 1:
+        nodes += (s.bridge.n_spans - 1) * (s.piers.elements + 1)
+    if s.track.model == 'slab':
+        t = s.track
+        approach = t.approach_length or (s.train.n_cars * s.train.car_length + 20.0)
+        pitch = t.fasteners_per_slab * t.fastener_spacing
+        units = math.ceil((_bridge_length(s) + 2.0 * approach) / pitch)
+        fasteners = units * t.fasteners_per_slab
+        nodes += 2 * ((fasteners - 1) * t.rail_elements_per_bay + 1)
+        nodes += 2 * units * (t.fasteners_per_slab + 2)
+    return nodes
+
+
+def _check_model_size(s: Scenario) -> None:
+    """Refuse a model too large to build (memory and set-up time), before building it."""
+    nodes = model_nodes(s)
+    if nodes > MAX_MODEL_NODES:
+        track = ''
+        if s.track.model == 'slab':
+            track = (', track.approach_length, track.fastener_spacing, '
+                     'track.rail_elements_per_bay')
+        raise ScenarioError(
+            f'the model would have {nodes} beam nodes (about {6 * nodes:.3g} DOFs), over the '
+            f'limit of {MAX_MODEL_NODES}: reduce bridge.n_spans = {s.bridge.n_spans}, '
+            f'bridge.span_length = {s.bridge.span_length:g} m, bridge.elements_per_span = '
+            f'{s.bridge.elements_per_span}{track}')
 
 
 def _bridge_length(s: Scenario) -> float:
