@@ -42,7 +42,7 @@ setup(
                  'flake8-quotes', 'flake8-import-order', 'flake8-builtins',
                  'flake8-comprehensions', 'flake8-class-newline', 'flake8-blind-except',
                  'flake8-deprecated', 'flake8-docstrings', 'pydocstyle>=6',
-                 'import-linter>=2', 'mypy>=1.10', 'types-PyYAML'],
+                 'import-linter>=2', 'mypy>=1.10', 'types-PyYAML', 'hypothesis>=6.100'],
     },
     package_data={'ttb_sim': ['py.typed']},
     zip_safe=True,

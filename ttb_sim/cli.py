@@ -26,8 +26,11 @@ from __future__ import annotations
 
 import argparse
 import logging
+import os
 from pathlib import Path
+import signal
 import sys
+import threading
 from typing import Sequence
 
 from ttb_sim import __version__
@@ -35,7 +38,7 @@ from ttb_sim.errors import ModelError, ScenarioError, TtbSimError
 
 log = logging.getLogger('ttb_sim')
 
-EXIT_OK, EXIT_FAILURE, EXIT_USAGE = 0, 1, 2
+EXIT_OK, EXIT_FAILURE, EXIT_USAGE, EXIT_INTERRUPTED = 0, 1, 2, 130
 
 
 def _parser() -> argparse.ArgumentParser:
@@ -56,6 +59,8 @@ def _parser() -> argparse.ArgumentParser:
     run.add_argument('--set', dest='overrides', action='append', default=[],
                      metavar='KEY=VALUE', help='override a scenario key (YAML scalar); '
                      'repeatable')
+    run.add_argument('--force', action='store_true', help='run even when the plan exceeds '
+                     'the step budget (2e7 time steps)')
 
     val = sub.add_parser('validate', help='run the validation suite and print a table')
     val.add_argument('cases', nargs='*', metavar='CASE', help='case ids (default: all)')
@@ -83,8 +88,26 @@ def _parser() -> argparse.ArgumentParser:
     return p
 
 
+def _stop_now(signum: int, frame: object) -> None:
+    """Before a verb takes over the signals nothing is written: end at once, one line."""
+    name = 'SIGTERM' if signum == signal.SIGTERM else 'SIGINT'
+    os.write(2, f'ttb-sim: stopped by {name}\n'.encode())
+    os._exit(128 + signum)
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Run the command line; return the exit code."""
+    previous = {}
+    if threading.current_thread() is threading.main_thread():
+        previous = {sig: signal.signal(sig, _stop_now) for sig in (signal.SIGINT, signal.SIGTERM)}
+    try:
+        return _main(argv)
+    finally:
+        for sig, handler in previous.items():
+            signal.signal(sig, handler)
+
+
+def _main(argv: Sequence[str] | None) -> int:
     parser = _parser()
     args = parser.parse_args(argv)
     logging.basicConfig(level=logging.INFO if args.verbose else logging.WARNING,
@@ -94,7 +117,7 @@ def main(argv: Sequence[str] | None = None) -> int:
             from ttb_sim.commands.run import run
             return run(args.scenario, out=args.out, storage=args.storage,
                        overrides=args.overrides, speed_kmh=args.speed_kmh,
-                       duration=args.duration)
+                       duration=args.duration, force=args.force)
         if args.command == 'validate':
             from ttb_sim.commands.validate import validate
             return validate(args.cases, list_only=args.list)
@@ -112,6 +135,12 @@ def main(argv: Sequence[str] | None = None) -> int:
     except TtbSimError as exc:
         print(f'ttb-sim: failed: {exc}', file=sys.stderr)
         return EXIT_FAILURE
+    except BrokenPipeError:  # stdout closed early (`ttb-sim scenarios | head`): not an error
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        return EXIT_OK
+    except KeyboardInterrupt:  # before a verb installed its own handler
+        print('ttb-sim: stopped by SIGINT', file=sys.stderr)
+        return EXIT_INTERRUPTED
 
 
 if __name__ == '__main__':  # pragma: no cover

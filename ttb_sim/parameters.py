@@ -32,6 +32,7 @@ import math
 from typing import Any, Sequence
 
 from ttb_sim.errors import ModelError
+from ttb_sim.inputs import shown
 
 __all__ = ['check_declared', 'param', 'Spec']
 
@@ -140,7 +141,7 @@ def check_declared(record: Any, what: str) -> None:
         kind = f.type if isinstance(f.type, str) else getattr(f.type, '__name__', '')
         if kind == 'bool':
             if not isinstance(value, bool):
-                raise ModelError(f'{what} {f.name} = {value!r} is invalid; allowed: true or '
+                raise ModelError(f'{what} {f.name} = {shown(value)} is invalid; allowed: true or '
                                  'false')
         elif kind in ('int', 'float'):
             number = isinstance(value, (int, float)) and not isinstance(value, bool)
@@ -148,8 +149,8 @@ def check_declared(record: Any, what: str) -> None:
                 number = False
             if not number or not math.isfinite(value) or not spec.contains(value):
                 integer = 'an integer in ' if kind == 'int' else ''
-                raise ModelError(f'{what} {f.name} = {value!r} is invalid; allowed: '
+                raise ModelError(f'{what} {f.name} = {shown(value)} is invalid; allowed: '
                                  f'{integer}{spec.allowed()}')
         elif kind == 'str' and spec.choices is not None and value not in spec.choices:
-            raise ModelError(f'{what} {f.name} = {value!r} is invalid; allowed: '
+            raise ModelError(f'{what} {f.name} = {shown(value)} is invalid; allowed: '
                              f'{spec.allowed()}')

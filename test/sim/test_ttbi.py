@@ -188,7 +188,7 @@ def test_bad_observers_are_rejected(entry, words):
 
 
 def test_observer_off_the_track_is_rejected():
-    with pytest.raises(ScenarioError, match='output.observers.0. = far=rail_left@9999'):
+    with pytest.raises(ScenarioError, match="output.observers.0. = 'far=rail_left@9999'"):
         small_car(0.01, [('output.observers', ['far=rail_left@9999'])])
 
 

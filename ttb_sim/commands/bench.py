@@ -48,6 +48,7 @@ from typing import Any, Callable, Sequence
 import numpy as np
 
 from ttb_sim.errors import DivergenceError, ScenarioError, SimulationError
+from ttb_sim.inputs import shown
 
 log = logging.getLogger(__name__)
 
@@ -86,7 +87,7 @@ def check_variants(names: Sequence[str]) -> list[str]:
     for name in names:
         if name not in allowed:
             choices = ', '.join(repr(c) for c in allowed)
-            raise ScenarioError(f'solver.variant = {name!r}: allowed values are one of '
+            raise ScenarioError(f'solver.variant = {shown(name)}: allowed values are one of '
                                 f'{choices}')
     ordered = [REFERENCE] + [n for n in dict.fromkeys(names) if n != REFERENCE]
     return ordered

@@ -25,17 +25,20 @@ from __future__ import annotations
 from dataclasses import dataclass
 import json
 import logging
+import os
 from pathlib import Path
 import signal
 import sys
 import time
-from typing import Any, Callable, Sequence
+from typing import Any, Callable, NoReturn, Sequence
 
 from ttb_sim import __version__
 from ttb_sim.config import load_scenario, Scenario
 from ttb_sim.errors import DivergenceError
-from ttb_sim.io.bag import BagRecorder, check_destination, default_bag_path
+from ttb_sim.io.bag import BagRecorder, check_destination, default_bag_path, make_parents
 from ttb_sim.io.topics import PeakTracker, topic_table
+from ttb_sim.model.vehicle.train import MultibodyCars
+from ttb_sim.sim.cost import CostEstimate, estimate_cost, STEP_BUDGET
 from ttb_sim.sim.simulation import Simulation
 
 log = logging.getLogger(__name__)
@@ -44,16 +47,42 @@ EXIT_OK, EXIT_FAILURE = 0, 1
 
 
 class StopFlag:
-    """Signal handler that records SIGINT / SIGTERM for the run loop to poll."""
+    """
+    Signal handler for SIGINT / SIGTERM, installed before set-up.
+
+    During set-up (:attr:`setup` True) nothing has been written, so a signal
+    ends the process at once with one line on stderr and exit 128 + signal
+    (:func:`exit_on_signal`): no exception has to unwind through half-imported
+    extension modules or a factorisation. Once recording starts (:attr:`setup`
+    False) a signal only sets the flag, which the run loop polls between
+    frames, so that no message is ever half-written.
+    """
 
     def __init__(self) -> None:
         self.signal: int | None = None
+        self.setup = True
 
     def __call__(self, signum: int, frame: object) -> None:
+        if self.setup:
+            exit_on_signal(signum, 'during set-up; nothing written')
         self.signal = signum
 
     def __bool__(self) -> bool:
         return self.signal is not None
+
+
+def exit_on_signal(signum: int, detail: str) -> NoReturn:
+    """Write 'ttb-sim: stopped by SIGNAME <detail>' to stderr; end the process (128 + signum)."""
+    os.write(2, f'ttb-sim: stopped by {signal_name(signum)} {detail}\n'.encode())
+    os._exit(128 + signum)
+
+
+def signal_name(signum: int | None) -> str:
+    """Return 'SIGINT', 'SIGTERM', ... for a signal number."""
+    try:
+        return signal.Signals(signum).name if signum else 'a signal'
+    except ValueError:
+        return f'signal {signum}'
 
 
 @dataclass
@@ -69,7 +98,8 @@ class RunResult:
 def run_to_bag(scenario: Scenario, out: Path, storage: str = 'mcap',
                progress: Callable[[int], None] | None = None,
                simulation: Simulation | None = None,
-               should_stop: Callable[[], bool] | None = None) -> RunResult:
+               should_stop: Callable[[], bool] | None = None,
+               setup_time: float = 0.0, estimate: CostEstimate | None = None) -> RunResult:
     """
     Simulate a scenario and record it.
 
@@ -89,6 +119,12 @@ def run_to_bag(scenario: Scenario, out: Path, storage: str = 'mcap',
         Polled between frames; when it returns True the run stops cleanly with
         status 'interrupted' (signal handlers set such a flag, so that no
         exception ever interrupts a message half-written).
+    setup_time : float
+        Seconds already spent on set-up (loading, building) by the caller; the
+        time to build ``simulation`` here, when it is not given, is added.
+    estimate : CostEstimate, optional
+        The cost estimate told to the user (made here when not given); it is
+        written to ``summary.json``.
 
     Returns
     -------
@@ -105,10 +141,13 @@ def run_to_bag(scenario: Scenario, out: Path, storage: str = 'mcap',
     """
     out = Path(out)
     check_destination(out, storage)  # before summary.json could land in someone's folder
+    built = time.perf_counter()
     sim = simulation or Simulation(scenario)
+    setup_time += time.perf_counter() - built
     topics = topic_table(sim.layout)
+    estimate = estimate or plan_cost(sim, len(topics))
     peaks = PeakTracker(topics)
-    out.parent.mkdir(parents=True, exist_ok=True)
+    make_parents(out)
     status, message, frames, last_time = 'ok', '', 0, 0.0
     start = time.perf_counter()
     try:
@@ -129,7 +168,8 @@ def run_to_bag(scenario: Scenario, out: Path, storage: str = 'mcap',
         status, message = 'interrupted', 'interrupted by a signal'
         raise
     finally:
-        wall = time.perf_counter() - start
+        stepping = time.perf_counter() - start
+        wall = setup_time + stepping
         summary = {
             'ttb_sim_version': __version__,
             'status': status,
@@ -142,6 +182,9 @@ def run_to_bag(scenario: Scenario, out: Path, storage: str = 'mcap',
                        'output_every_steps': sim.output_every},
             'frames': frames,
             'simulated_time': last_time,
+            'estimate': estimate.as_dict(),
+            'setup_time': setup_time,
+            'stepping_time': stepping,
             'wall_time': wall,
             'real_time_factor': last_time / wall if wall > 0 else None,
             'peaks': peaks.summary(),
@@ -152,9 +195,17 @@ def run_to_bag(scenario: Scenario, out: Path, storage: str = 'mcap',
     return RunResult(path=out, status=status, summary=summary)
 
 
+def plan_cost(sim: Simulation, messages_per_frame: int) -> CostEstimate:
+    """Return the cost estimate of a built simulation (before it runs)."""
+    cars = sim.vehicle.n_cars if isinstance(sim.vehicle, MultibodyCars) else 0
+    return estimate_cost(steps=sim.n_steps, dt=sim.dt, free_dofs=sim.structure.n_free,
+                         cars=cars, frames=sim.n_frames, messages_per_frame=messages_per_frame,
+                         variant=sim.scenario.solver.variant)
+
+
 def run(scenario: str | Path, *, out: Path | None = None, storage: str = 'mcap',
         overrides: Sequence[str] = (), speed_kmh: float | None = None,
-        duration: float | None = None) -> int:
+        duration: float | None = None, force: bool = False) -> int:
     """
     Run ``ttb-sim run``: load, build, simulate to a bag; return the exit code.
 
@@ -170,32 +221,34 @@ def run(scenario: str | Path, *, out: Path | None = None, storage: str = 'mcap',
         ``KEY=VALUE`` strings (YAML scalars).
     speed_kmh, duration
         Shortcuts for ``train.speed_kmh`` and ``solver.duration``.
+    force
+        Run even above the step budget (:data:`~ttb_sim.sim.cost.STEP_BUDGET`).
 
     Raises
     ------
     ScenarioError
-        Before anything is written, for a bad scenario or destination.
+        Before anything is written, for a bad scenario or destination, or a
+        plan over the step budget without ``force``.
 
     """
-    values = []
-    if speed_kmh is not None:
-        values.append(('train.speed_kmh', speed_kmh))
-    if duration is not None:
-        values.append(('solver.duration', duration))
-    loaded = load_scenario(scenario, overrides, values)
-    simulation = Simulation(loaded)
-    out = out if out is not None else default_bag_path(loaded.name)
-    bar = None
-    if sys.stderr.isatty():
-        from tqdm import tqdm
-        bar = tqdm(total=simulation.n_frames, unit='frame', desc=loaded.name,
-                   file=sys.stderr, leave=False)
+    start = time.perf_counter()
     stop = StopFlag()
     previous = {sig: signal.signal(sig, stop) for sig in (signal.SIGINT, signal.SIGTERM)}
+    bar = None
     try:
+        loaded, out, simulation = _set_up(scenario, out, storage, overrides, speed_kmh,
+                                          duration, force)
+        estimate = plan_cost(simulation, len(topic_table(simulation.layout)))
+        print(f'ttb-sim: plan: {estimate.describe()}', file=sys.stderr)
+        stop.setup = False  # from here on a signal closes the bag cleanly
+        if sys.stderr.isatty():
+            from tqdm import tqdm
+            bar = tqdm(total=simulation.n_frames, unit='frame', desc=loaded.name,
+                       file=sys.stderr, leave=False)
         result = run_to_bag(loaded, out, storage,
                             progress=bar.update if bar is not None else None,
-                            simulation=simulation, should_stop=stop.__bool__)
+                            simulation=simulation, should_stop=stop.__bool__,
+                            setup_time=time.perf_counter() - start, estimate=estimate)
     finally:
         for sig, handler in previous.items():
             signal.signal(sig, handler)
@@ -203,14 +256,30 @@ def run(scenario: str | Path, *, out: Path | None = None, storage: str = 'mcap',
             bar.close()
     s = result.summary
     if result.status == 'interrupted':
-        name = signal.Signals(stop.signal).name if stop.signal else 'signal'
-        print(f'ttb-sim: stopped by {name}; bag closed at {out} with {s["frames"]} frames',
-              file=sys.stderr)
+        print(f'ttb-sim: stopped by {signal_name(stop.signal)}; bag closed at {out} with '
+              f'{s["frames"]} frames', file=sys.stderr)
         return 128 + (stop.signal or signal.SIGINT)
     if result.status == 'diverged':
         print(f'ttb-sim: failed: {s["message"]}; bag closed at {out} with {s["frames"]} '
               'frames', file=sys.stderr)
         return EXIT_FAILURE
     print(f'{out}: {s["frames"]} frames, {s["simulated_time"]:.3f} s simulated in '
-          f'{s["wall_time"]:.2f} s (real-time factor {s["real_time_factor"]:.3g})')
+          f'{s["wall_time"]:.2f} s (set-up {s["setup_time"]:.2f} s; real-time factor '
+          f'{s["real_time_factor"]:.3g})')
     return EXIT_OK
+
+
+def _set_up(scenario: str | Path, out: Path | None, storage: str, overrides: Sequence[str],
+            speed_kmh: float | None, duration: float | None, force: bool
+            ) -> tuple[Scenario, Path, Simulation]:
+    """Load the scenario, check the destination, then build the model (in that order)."""
+    values: list[tuple[str, Any]] = []
+    if speed_kmh is not None:
+        values.append(('train.speed_kmh', speed_kmh))
+    if duration is not None:
+        values.append(('solver.duration', duration))
+    loaded = load_scenario(scenario, overrides, values)
+    out = Path(out) if out is not None else default_bag_path(loaded.name)
+    check_destination(out, storage)  # before the model is built: a bad --out fails at once
+    log.info('set-up: building the model of %s', loaded.name)
+    return loaded, out, Simulation(loaded, max_steps=None if force else STEP_BUDGET)

@@ -16,12 +16,24 @@
 
 from __future__ import annotations
 
+import sys
 from typing import Sequence
 
 from ttb_sim.errors import ScenarioError
 from ttb_sim.validation.cases.registry import CASES, format_table, run_cases
+from ttb_sim.validation.rows import Row
 
 EXIT_OK, EXIT_FAILURE = 0, 1
+
+
+def _progress(i: int, n: int, case_id: str, rows: list[Row] | None, seconds: float) -> None:
+    """Tell stderr which case runs, and how it ended, as the suite goes."""
+    if rows is None:
+        print(f'[{i}/{n}] {case_id} {CASES[case_id].title} ...', file=sys.stderr, flush=True)
+        return
+    failed = sum(not r.passed for r in rows)
+    verdict = 'pass' if failed == 0 else f'FAIL ({failed} of {len(rows)} rows)'
+    print(f'[{i}/{n}] {case_id} {verdict} in {seconds:.1f} s', file=sys.stderr, flush=True)
 
 
 def validate(cases: Sequence[str] = (), *, list_only: bool = False) -> int:
@@ -34,7 +46,7 @@ def validate(cases: Sequence[str] = (), *, list_only: bool = False) -> int:
     if unknown:
         raise ScenarioError(f'unknown validation case(s) {", ".join(unknown)}; allowed: '
                             f'{", ".join(CASES)}')
-    rows = run_cases(cases or list(CASES))
+    rows = run_cases(cases or list(CASES), progress=_progress)
     print(format_table(rows))
     failed = sum(not r.passed for r in rows)
     print(f'{len(rows) - failed} passed, {failed} failed')

@@ -22,13 +22,13 @@ their declarations (keys, types, ranges) and builds them from plain data, and
 
 from ttb_sim.config.loader import (apply_overrides, builtin_scenarios, config_dirs, load_scenario,
                                    parse_override, read_yaml, resolve)
-from ttb_sim.config.records import (IrregularityConfig, Observer, OBSERVER_COMPONENTS,
+from ttb_sim.config.records import (car_layout, IrregularityConfig, Observer, OBSERVER_COMPONENTS,
                                     OutputConfig, parse_observers, Scenario, SolverConfig,
                                     TrainConfig)
 from ttb_sim.config.schema import from_mapping, iter_keys, key_spec, to_plain
 from ttb_sim.parameters import param, Spec
 
-__all__ = ['apply_overrides', 'builtin_scenarios', 'config_dirs', 'from_mapping',
+__all__ = ['apply_overrides', 'builtin_scenarios', 'car_layout', 'config_dirs', 'from_mapping',
            'IrregularityConfig', 'iter_keys', 'key_spec', 'load_scenario', 'Observer',
            'OBSERVER_COMPONENTS', 'OutputConfig', 'param', 'parse_observers',
            'parse_override', 'read_yaml', 'resolve', 'Scenario', 'SolverConfig', 'Spec',

@@ -25,11 +25,50 @@ from typing import Any, Sequence
 from ttb_sim.config.records import Scenario
 from ttb_sim.config.schema import canonical_key, from_mapping, key_spec
 from ttb_sim.errors import ScenarioError
+from ttb_sim.inputs import MAX_SHOWN, read_user_file, shown
 import yaml
 
 
+MAX_SCENARIO_BYTES = 1 << 20
+"""Largest scenario file read (bytes): built-ins are about 2 kB."""
+MAX_YAML_DEPTH = 32
+"""Deepest nesting of YAML collections accepted (a scenario needs three levels)."""
+
+
 class YamlLoader(yaml.SafeLoader):
-    """Safe YAML loader that also reads 1e6 and 1.5e-3 as floats (as YAML 1.2 does)."""
+    """
+    Safe YAML loader for scenarios: bounded, and 1e6 and 1.5e-3 read as floats (as YAML 1.2).
+
+    Anchors and aliases (``&name``, ``*name``, ``<<: *name``) are refused: a
+    scenario never needs them, and aliases nested a few levels deep (a
+    "billion laughs" text of a few hundred bytes) expand to more items than
+    memory holds. Collections nested deeper than :data:`MAX_YAML_DEPTH` are
+    refused before the recursive composer can exhaust the stack.
+    """
+
+    def __init__(self, stream: str) -> None:
+        super().__init__(stream)
+        self._depth = 0
+
+    def compose_node(self, parent: Any, index: Any) -> Any:
+        """Compose one node, refusing anchors, aliases and deep nesting."""
+        event = self.peek_event()
+        if isinstance(event, yaml.AliasEvent) or getattr(event, 'anchor', None) is not None:
+            raise yaml.composer.ComposerError(
+                None, None, 'anchors and aliases (&name, *name) are not allowed in scenario '
+                'YAML; write the value out', event.start_mark)
+        collection = isinstance(event, (yaml.SequenceStartEvent, yaml.MappingStartEvent))
+        if collection:
+            self._depth += 1
+            if self._depth > MAX_YAML_DEPTH:
+                raise yaml.composer.ComposerError(
+                    None, None, f'collections nested deeper than {MAX_YAML_DEPTH} levels',
+                    event.start_mark)
+        try:
+            return super().compose_node(parent, index)
+        finally:
+            if collection:
+                self._depth -= 1
 
 
 YamlLoader.yaml_implicit_resolvers = {
@@ -45,9 +84,55 @@ YamlLoader.add_implicit_resolver(
     list('-+0123456789.'))
 
 
-def read_yaml(text: str) -> Any:
-    """Parse YAML text with :class:`YamlLoader`."""
-    return yaml.load(text, Loader=YamlLoader)  # noqa: S506 - a SafeLoader subclass
+def read_yaml(text: str, name: str = '<text>') -> Any:
+    """
+    Parse YAML text with :class:`YamlLoader`.
+
+    Parameters
+    ----------
+    text : str
+        The YAML text.
+    name : str
+        What the text is (a file name), for positions in error messages.
+
+    Raises
+    ------
+    yaml.YAMLError
+        For invalid YAML, anchors or aliases, or nesting deeper than
+        :data:`MAX_YAML_DEPTH`; also for a value YAML cannot construct (a
+        timestamp such as 2001-13-45, an integer of over 4300 digits, an empty
+        ``!!float``), which PyYAML reports as ValueError or IndexError.
+
+    """
+    loader = YamlLoader(text)
+    loader.name = name
+    try:
+        return loader.get_single_data()
+    except (ValueError, IndexError, TypeError, OverflowError) as exc:
+        # A scalar PyYAML's constructors fail on: an over-long integer or a bad timestamp
+        # (ValueError), an empty '!!float' (IndexError).
+        raise yaml.YAMLError(f'a value cannot be read ({shown(str(exc))})') from None
+    except RecursionError:  # pragma: no cover - the depth bound comes first
+        raise yaml.YAMLError('nesting too deep') from None
+    finally:
+        loader.dispose()
+
+
+def yaml_problem(exc: yaml.YAMLError) -> str:
+    """
+    Return a YAML error as one bounded line: what is wrong, and where (file, line, column).
+
+    PyYAML's own text spans several lines and quotes the offending line, which
+    may be arbitrarily long.
+    """
+    if not isinstance(exc, yaml.MarkedYAMLError):
+        return shown(str(exc))[1:-1] if len(str(exc)) > MAX_SHOWN else str(exc)
+    parts = [p for p in (exc.context, exc.problem) if p]
+    what = shown('; '.join(parts))[1:-1] if parts else 'invalid YAML'
+    mark = exc.problem_mark or exc.context_mark
+    if mark is None:
+        return what
+    return f'{what} (in "{mark.name}", line {mark.line + 1}, column {mark.column + 1})'
 
 
 def config_dirs() -> list[Path]:
@@ -101,16 +186,17 @@ def resolve(source: str | Path) -> Path:
 
     """
     path = Path(source)
-    if path.suffix in ('.yaml', '.yml') or path.exists():
-        if not path.is_file():
-            raise ScenarioError(f'scenario file {str(path)!r} does not exist')
-        return path
+    yaml_name = path.suffix in ('.yaml', '.yml')
+    if path.is_file() or (yaml_name and not path.is_dir()):
+        return path  # read_user_file refuses what is missing or not a regular file
     builtins = builtin_scenarios()
-    if str(source) in builtins:
-        return builtins[str(source)]
+    if not yaml_name and str(source) in builtins:
+        return builtins[str(source)]  # a folder named like a built-in does not hide it
+    if path.exists():
+        read_user_file(path, 'scenario file', MAX_SCENARIO_BYTES)  # says what it is instead
     names = ', '.join(sorted(builtins)) or '(none found)'
-    raise ScenarioError(f'no scenario {str(source)!r}: give a YAML path or a built-in name '
-                        f'({names})')
+    raise ScenarioError(f'no scenario {shown(str(source))}: give a YAML path or a built-in '
+                        f'name ({names})')
 
 
 def parse_override(text: str) -> tuple[str, Any]:
@@ -124,13 +210,15 @@ def parse_override(text: str) -> tuple[str, Any]:
 
     """
     if '=' not in text:
-        raise ScenarioError(f'--set {text!r}: expected KEY=VALUE, e.g. bridge.span_length=25')
+        raise ScenarioError(f'--set {shown(text)}: expected KEY=VALUE, e.g. '
+                            'bridge.span_length=25')
     key, raw = text.split('=', 1)
     key = key.strip()
     try:
-        value = read_yaml(raw) if raw.strip() else ''
+        value = read_yaml(raw, f'--set {key}') if raw.strip() else ''
     except yaml.YAMLError as exc:
-        raise ScenarioError(f'--set {text!r}: value is not valid YAML ({exc})') from None
+        raise ScenarioError(f'--set {shown(text)}: value is not valid YAML '
+                            f'({yaml_problem(exc)})') from None
     return key, value
 
 
@@ -184,18 +272,18 @@ def load_scenario(source: str | Path, overrides: Sequence[str] = (),
 
     """
     path = resolve(source)
+    text = read_user_file(path, 'scenario file', MAX_SCENARIO_BYTES)
+    name = shown(str(path))
     try:
-        text = path.read_text(encoding='utf-8')
-    except (OSError, UnicodeDecodeError) as exc:
-        raise ScenarioError(f'cannot read scenario file {str(path)!r}: {exc}') from None
-    try:
-        data = read_yaml(text)
+        data = read_yaml(text, str(path))
     except yaml.YAMLError as exc:
-        raise ScenarioError(f'scenario file {str(path)!r} is not valid YAML: {exc}') from None
+        raise ScenarioError(f'scenario file {name} is not valid YAML: '
+                            f'{yaml_problem(exc)}') from None
     if data is None:
         data = {}
     if not isinstance(data, dict):
-        raise ScenarioError(f'scenario file {str(path)!r} must hold a mapping of keys')
+        raise ScenarioError(f'scenario file {name} must hold a mapping of keys, got '
+                            f'{shown(data)}')
     data.setdefault('name', path.stem)
     apply_overrides(data, [parse_override(o) for o in overrides] + list(values))
     return from_mapping(data)

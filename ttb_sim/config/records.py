@@ -36,9 +36,10 @@ from typing import Any, Sequence
 
 from ttb_sim.config.schema import to_plain
 from ttb_sim.errors import ScenarioError
+from ttb_sim.inputs import shown
 from ttb_sim.model.bridge import (BearingParameters, BridgeParameters, FoundationParameters,
-                                  PierParameters)
-from ttb_sim.model.track import TrackParameters
+                                  PierParameters, span_frequency)
+from ttb_sim.model.track import track_extent, TrackExtent, TrackParameters
 from ttb_sim.model.vehicle.car import CarParameters
 from ttb_sim.model.wheel_rail.parameters import ContactParameters
 from ttb_sim.parameters import param
@@ -101,9 +102,11 @@ class IrregularityConfig:
                       high=2**31 - 1, dynamic=True)
     scale: float = param(1.0, '-', 'Factor on the irregularity amplitude; 0 gives a smooth '
                          'track.', low=0.0, high=100.0, dynamic=True)
-    file: str = param('', '-', 'CSV of a measured profile (x, z_left, z_right, y_left, '
-                      'y_right in metres; smooth outside its range); empty = synthesise '
-                      'from the spectrum.', dynamic=True)
+    file: str = param('', '-', 'CSV of a measured profile in metres: a header row naming '
+                      'x, z_left, z_right, y_left, y_right (any order; other columns are '
+                      'ignored), or no header and exactly these five numeric columns in this '
+                      'order; a regular file of at most 64 MiB; smooth outside its range. '
+                      'Empty = synthesise from the spectrum.', dynamic=True)
     grid_spacing: float = param(0.01, 'm', 'Grid spacing of the synthesised profile (must be '
                                 'under half the shortest wavelength).', low=0.001, high=1.0)
 
@@ -176,15 +179,20 @@ class Scenario:
         """Distances of all axles behind the head (m): ``train.axle_offsets`` or the car layout."""
         if self.train.axle_offsets:
             return tuple(float(a) for a in self.train.axle_offsets)
-        lc, lt = self.car.bogie_semi_spacing, self.car.wheelbase_semi
-        length = self.train.car_length
-        first = length / 2.0 - lc - lt
-        local = (first, first + 2 * lt, first + 2 * lc, first + 2 * lc + 2 * lt)
-        return tuple(k * length + a for k in range(self.train.n_cars) for a in local)
+        return car_layout(self.train, self.car)
 
     def to_dict(self) -> dict[str, Any]:
         """Return the scenario as plain nested dicts (for echo in summaries)."""
         return to_plain(dataclasses.asdict(self))
+
+
+def car_layout(train: TrainConfig, car: CarParameters) -> tuple[float, ...]:
+    """Distances of the axles of ``train.n_cars`` cars behind the head (m), by car geometry."""
+    lc, lt = car.bogie_semi_spacing, car.wheelbase_semi
+    length = train.car_length
+    first = length / 2.0 - lc - lt
+    local = (first, first + 2 * lt, first + 2 * lc, first + 2 * lc + 2 * lt)
+    return tuple(k * length + a for k in range(train.n_cars) for a in local)
 
 
 def _check_consistency(s: Scenario) -> None:
@@ -200,7 +208,110 @@ def _check_consistency(s: Scenario) -> None:
     if s.track.model == 'slab' and s.train.vehicle != 'car':
         raise ScenarioError(f"track.model = 'slab' needs train.vehicle = 'car' (got "
                             f'{s.train.vehicle!r})')
-    s.output.points  # parse (and so check) the observers once
+    _check_model_size(s)
+    _check_track_fit(s)
+    _check_observers(s)
+
+
+MAX_MODEL_NODES = 200_000
+"""Most finite-element nodes a scenario may ask for (about 1.2 million DOFs; paper_ttbi: 8 000)."""
+
+
+def model_nodes(s: Scenario) -> int:
+    """Count the beam nodes the model of a scenario will have, before building it."""
+    nodes = s.bridge.n_spans * (s.bridge.elements_per_span + 1)
+    if s.bridge.n_spans > 1:
+        nodes += (s.bridge.n_spans - 1) * (s.piers.elements + 1)
+    if s.track.model == 'slab':
+        t = s.track
+        approach = t.approach_length or (s.train.n_cars * s.train.car_length + 20.0)
+        pitch = t.fasteners_per_slab * t.fastener_spacing
+        units = math.ceil((_bridge_length(s) + 2.0 * approach) / pitch)
+        fasteners = units * t.fasteners_per_slab
+        nodes += 2 * ((fasteners - 1) * t.rail_elements_per_bay + 1)
+        nodes += 2 * units * (t.fasteners_per_slab + 2)
+    return nodes
+
+
+def _check_model_size(s: Scenario) -> None:
+    """Refuse a model too large to build (memory and set-up time), before building it."""
+    nodes = model_nodes(s)
+    if nodes > MAX_MODEL_NODES:
+        track = ''
+        if s.track.model == 'slab':
+            track = (', track.approach_length, track.fastener_spacing, '
+                     'track.rail_elements_per_bay')
+        raise ScenarioError(
+            f'the model would have {nodes} beam nodes (about {6 * nodes:.3g} DOFs), over the '
+            f'limit of {MAX_MODEL_NODES}: reduce bridge.n_spans = {s.bridge.n_spans}, '
+            f'bridge.span_length = {s.bridge.span_length:g} m, bridge.elements_per_span = '
+            f'{s.bridge.elements_per_span}{track}')
+
+
+def _bridge_length(s: Scenario) -> float:
+    return s.bridge.n_spans * s.bridge.span_length
+
+
+def _extent(s: Scenario) -> TrackExtent:
+    return track_extent(s.track, _bridge_length(s), s.train.n_cars * s.train.car_length)
+
+
+def _check_track_fit(s: Scenario) -> None:
+    """Refuse a car run whose wheels would start or end off the modelled rails."""
+    if s.train.vehicle != 'car':
+        return
+    ext = _extent(s)
+    offsets = car_layout(s.train, s.car)
+    head = s.train.start_position
+    where = (f'the modelled rails run from x = {ext.rail_start:.2f} to {ext.rail_end:.2f} m '
+             f'(track.approach_length = {s.track.approach_length:g} m'
+             f'{" = automatic" if not s.track.approach_length else ""} before and after the '
+             f'{_bridge_length(s):g} m bridge)')
+    rear, front = head - max(offsets), head - min(offsets)
+    if rear < ext.rail_start or front > ext.rail_end:
+        raise ScenarioError(
+            f'train.start_position = {head:g} m: the axles would start at x = {rear:.2f} .. '
+            f'{front:.2f} m, off the track: {where}; move the train or lengthen '
+            'track.approach_length')
+    speed = s.train.speed
+    f1 = span_frequency(s.bridge.span_length, s.bridge.bending_stiffness,
+                        s.bridge.mass_per_length)
+    if s.solver.duration > 0.0:
+        travel = speed * s.solver.duration
+        key = f'solver.duration = {s.solver.duration:g} s'
+    else:
+        exit_position = _bridge_length(s) + max(offsets)
+        travel = max(exit_position - head, 0.0) + speed * s.solver.free_vibration_periods / f1
+        key = ('solver.duration = 0 (automatic: until the last axle leaves the bridge plus '
+               f'solver.free_vibration_periods = {s.solver.free_vibration_periods:g} periods)')
+    front_end = front + travel
+    if front_end > ext.rail_end:
+        raise ScenarioError(
+            f'{key}: the run is longer than the track: the front axle would reach '
+            f'x = {front_end:.2f} m at {s.train.speed_kmh:g} km/h, but {where}; shorten '
+            'solver.duration or lengthen track.approach_length')
+
+
+def _check_observers(s: Scenario) -> None:
+    """Refuse observers on a component the scenario does not have, or off its extent."""
+    observers = s.output.points
+    length = _bridge_length(s)
+    for i, obs in enumerate(observers):
+        where = f'output.observers[{i}] = {shown(s.output.observers[i])}'
+        if obs.component == 'girder':
+            low, high = 0.0, length
+        elif s.track.model != 'slab':
+            raise ScenarioError(f'{where}: component {obs.component!r} needs '
+                                "track.model = 'slab'")
+        else:
+            ext = _extent(s)
+            if obs.component.startswith('rail'):
+                low, high = ext.rail_start, ext.rail_end
+            else:
+                low, high = ext.unit_start, ext.unit_end
+        if not low <= obs.x <= high:
+            raise ScenarioError(f'{where}: x is not on the {obs.component}, which runs from '
+                                f'{low:g} to {high:g} m')
 
 
 OBSERVER_COMPONENTS = ('rail_left', 'rail_right', 'slab', 'base', 'girder')
@@ -229,22 +340,22 @@ def parse_observers(entries: Sequence[str]) -> tuple[Observer, ...]:
     """
     out: list[Observer] = []
     for i, entry in enumerate(entries):
-        path = f'output.observers[{i}] = {entry!r}'
+        path = f'output.observers[{i}] = {shown(entry)}'
         match = _OBSERVER.match(entry.strip())
         if not match:
             raise ScenarioError(f"{path}: expected 'name=component@x' with a name of "
                                 'letters, digits and _ (starting with a letter)')
         name, component, x_text = match.groups()
         if component not in OBSERVER_COMPONENTS:
-            raise ScenarioError(f'{path}: component {component!r} is unknown; allowed: '
+            raise ScenarioError(f'{path}: component {shown(component)} is unknown; allowed: '
                                 f'{", ".join(OBSERVER_COMPONENTS)}')
         try:
             x = float(x_text)
         except ValueError:
             x = math.nan
         if not math.isfinite(x):
-            raise ScenarioError(f'{path}: position {x_text!r} is not a finite number (m)')
+            raise ScenarioError(f'{path}: position {shown(x_text)} is not a finite number (m)')
         if any(o.name == name for o in out):
-            raise ScenarioError(f'{path}: observer name {name!r} is used twice')
+            raise ScenarioError(f'{path}: observer name {shown(name)} is used twice')
         out.append(Observer(name, component, x))
     return tuple(out)

@@ -30,6 +30,7 @@ import typing
 from typing import Any, Iterator, Mapping
 
 from ttb_sim.errors import ModelError, ScenarioError
+from ttb_sim.inputs import shown
 from ttb_sim.parameters import Spec
 
 __all__ = ['ALIASES', 'canonical_key', 'from_mapping', 'iter_keys', 'key_spec',
@@ -42,6 +43,9 @@ ALIASES = {
 """Old key paths that still work, and the key each now sets (the car record owns the
 car geometry since the records were unified; scenario files and ``--set`` using the old
 paths keep working)."""
+
+MAX_LIST_ITEMS = 1000
+"""Most entries of a list-valued key (axle offsets, observers)."""
 
 
 def canonical_key(path: str) -> str:
@@ -111,7 +115,8 @@ def key_spec(path: str) -> tuple[type, Any, Spec]:
     for key, typ, default, spec in iter_keys():
         if key == path:
             return typ, default, spec
-    raise ScenarioError(f'unknown key {path!r}; see `ttb-sim scenarios --keys` for the list')
+    raise ScenarioError(f'unknown key {shown(path)}; see `ttb-sim scenarios --keys` for the '
+                        'list')
 
 
 def _root(cls: type | None) -> type:
@@ -151,7 +156,7 @@ def from_mapping(data: Mapping[str, Any], cls: type | None = None, prefix: str =
     cls = _root(cls)
     if not isinstance(data, Mapping):
         where = prefix[:-1] or 'the scenario'
-        raise ScenarioError(f'{where} must be a mapping of keys, got {data!r}')
+        raise ScenarioError(f'{where} must be a mapping of keys, got {shown(data)}')
     hints = _hints(cls)
     names = {f.name: f for f in dataclasses.fields(cls)}
     kwargs: dict[str, Any] = {}
@@ -159,7 +164,7 @@ def from_mapping(data: Mapping[str, Any], cls: type | None = None, prefix: str =
         path = f'{prefix}{key}'
         if key not in names:
             allowed = ', '.join(sorted(names))
-            raise ScenarioError(f'unknown key {path!r}; allowed here: {allowed}')
+            raise ScenarioError(f'unknown key {shown(path)}; allowed here: {allowed}')
         f = names[key]
         if 'spec' in f.metadata:
             kwargs[key] = _coerce(path, value, hints[key], f.metadata['spec'])
@@ -177,32 +182,36 @@ def from_mapping(data: Mapping[str, Any], cls: type | None = None, prefix: str =
 
 def _coerce(path: str, value: Any, typ: Any, spec: Spec) -> Any:
     """Check one value against its declared type and range, and return it typed."""
+    if isinstance(value, (list, tuple)) and len(value) > MAX_LIST_ITEMS:
+        raise ScenarioError(f'{path} = {shown(value)}: too many entries; at most '
+                            f'{MAX_LIST_ITEMS}')
     record = _record_item(typ)
     if record is not None:
         if not isinstance(value, (list, tuple)) or not value:
-            raise ScenarioError(f'{path} = {_short(value)}: expected a non-empty list of '
+            raise ScenarioError(f'{path} = {shown(value)}: expected a non-empty list of '
                                 f'mappings with keys {_field_names(record)}')
         return tuple(from_mapping(item, record, prefix=f'{path}[{i}].')
                      for i, item in enumerate(value))
     if typ in (tuple[float, ...],):
         if not isinstance(value, (list, tuple)):
-            raise ScenarioError(f'{path} = {value!r}: expected a list of numbers ({spec.unit})')
+            raise ScenarioError(f'{path} = {shown(value)}: expected a list of numbers '
+                                f'({spec.unit})')
         items = tuple(_coerce_number(f'{path}[{i}]', v, float, spec)
                       for i, v in enumerate(value))
         return items
     if typ in (tuple[str, ...],):
         if not isinstance(value, (list, tuple)) or not all(isinstance(v, str) for v in value):
-            raise ScenarioError(f'{path} = {value!r}: expected a list of strings')
+            raise ScenarioError(f'{path} = {shown(value)}: expected a list of strings')
         return tuple(value)
     if typ is bool:
         if not isinstance(value, bool):
-            raise ScenarioError(f'{path} = {value!r}: expected true or false')
+            raise ScenarioError(f'{path} = {shown(value)}: expected true or false')
         return value
     if typ is str:
         if not isinstance(value, str):
-            raise ScenarioError(f'{path} = {value!r}: expected a string, {spec.allowed()}')
+            raise ScenarioError(f'{path} = {shown(value)}: expected a string, {spec.allowed()}')
         if spec.choices is not None and value not in spec.choices:
-            raise ScenarioError(f'{path} = {value!r}: allowed values are {spec.allowed()}')
+            raise ScenarioError(f'{path} = {shown(value)}: allowed values are {spec.allowed()}')
         return value
     if typ in (float, int):
         return _coerce_number(path, value, typ, spec)
@@ -222,29 +231,23 @@ def _field_names(record: type) -> str:
     return ', '.join(f.name for f in dataclasses.fields(record))
 
 
-def _short(value: Any, limit: int = 200) -> str:
-    """Return repr(value), cut to ``limit`` characters with a note."""
-    text = repr(value)
-    return text if len(text) <= limit else f'{text[:limit]}... ({len(text)} characters)'
-
-
 def _coerce_number(path: str, value: Any, typ: type, spec: Spec) -> float | int:
     if isinstance(value, bool) or not isinstance(value, (int, float)):
         kind = 'an integer' if typ is int else 'a number'
-        raise ScenarioError(f'{path} = {value!r}: expected {kind}, allowed {spec.allowed()}')
+        raise ScenarioError(f'{path} = {shown(value)}: expected {kind}, allowed {spec.allowed()}')
     if typ is int:
         if isinstance(value, float):
             if not value.is_integer():
-                raise ScenarioError(f'{path} = {value!r}: expected an integer, allowed '
+                raise ScenarioError(f'{path} = {shown(value)}: expected an integer, allowed '
                                     f'{spec.allowed()}')
         value = int(value)
     else:
         value = float(value)
         if not math.isfinite(value):
-            raise ScenarioError(f'{path} = {value!r}: expected a finite number, allowed '
+            raise ScenarioError(f'{path} = {shown(value)}: expected a finite number, allowed '
                                 f'{spec.allowed()}')
     if not spec.contains(value):
-        raise ScenarioError(f'{path} = {value!r} is out of range: allowed {spec.allowed()}')
+        raise ScenarioError(f'{path} = {shown(value)} is out of range: allowed {spec.allowed()}')
     return value
 
 

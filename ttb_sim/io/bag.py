@@ -16,7 +16,10 @@
 
 from __future__ import annotations
 
+import os
 from pathlib import Path
+import signal
+import tempfile
 import time
 from types import TracebackType
 from typing import Any, Sequence
@@ -25,6 +28,7 @@ from rosbags.rosbag2 import StoragePlugin, Writer
 from rosbags.rosbag2.errors import WriterError
 from rosbags.typesys import get_typestore, Stores
 from ttb_sim.errors import ScenarioError
+from ttb_sim.inputs import shown
 from ttb_sim.io.topics import NAMESPACE, Topic
 from ttb_sim.sim.frames import Frame
 
@@ -34,19 +38,85 @@ STORAGES = {'mcap': StoragePlugin.MCAP, 'sqlite3': StoragePlugin.SQLITE3}
 
 def check_destination(path: str | Path, storage: str) -> None:
     """
-    Refuse an unknown storage or an existing bag directory, before anything is written.
+    Refuse a bag destination that cannot be created, before anything is built or written.
+
+    The destination must not exist (not even as a broken link); its nearest
+    existing ancestor must be a directory (not a file, which the path would be
+    inside) that this process may write into, so that the missing parents and
+    the bag directory can be made.
 
     Raises
     ------
     ScenarioError
-        Naming the storage and what is allowed, or the existing directory.
+        Naming the storage and what is allowed, or the destination and why it
+        cannot be used.
 
     """
     if storage not in STORAGES:
-        raise ScenarioError(f'storage {storage!r}: allowed values are {", ".join(STORAGES)}')
-    if Path(path).exists():
-        raise ScenarioError(f'output directory {str(path)!r} exists; refusing to overwrite it '
+        raise ScenarioError(f'storage {shown(storage)}: allowed values are {", ".join(STORAGES)}')
+    out = Path(path)
+    name = shown(str(path))
+    if out.exists() or out.is_symlink():
+        raise ScenarioError(f'output directory {name} exists; refusing to overwrite it '
                             '(choose another --out)')
+    try:
+        absolute = Path(os.path.abspath(out))
+    except (OSError, ValueError) as exc:
+        raise ScenarioError(f'output directory {name} is not a usable path ({exc})') from None
+    ancestor = absolute.parent
+    while not ancestor.exists() and ancestor != ancestor.parent:
+        if ancestor.is_symlink():
+            raise ScenarioError(f'output directory {name}: {shown(str(ancestor))} is a broken '
+                                'link')
+        ancestor = ancestor.parent
+    if not ancestor.is_dir():
+        raise ScenarioError(f'output directory {name} is inside {shown(str(ancestor))}, which '
+                            'is a file, not a directory')
+    what = 'parent directory' if ancestor == absolute.parent else 'nearest existing folder'
+    problem = None if os.access(ancestor, os.W_OK | os.X_OK) else 'permission denied'
+    if problem is None:  # access() says yes to root even on /proc or a read-only mount
+        problem = _probe(ancestor)
+    if problem is not None:
+        raise ScenarioError(f'output directory {name} cannot be created: the {what} '
+                            f'{shown(str(ancestor))} is not writable ({problem})')
+
+
+def _probe(folder: Path) -> str | None:
+    """
+    Make and remove a folder in ``folder``; return why that failed, or None.
+
+    SIGINT and SIGTERM are held for the instant the probe exists, so that a
+    signal handler which ends the process never leaves it behind.
+    """
+    held = {signal.SIGINT, signal.SIGTERM}
+    mask = hasattr(signal, 'pthread_sigmask')
+    if mask:
+        signal.pthread_sigmask(signal.SIG_BLOCK, held)
+    try:
+        os.rmdir(tempfile.mkdtemp(prefix='.ttb_sim-probe-', dir=folder))
+    except OSError as exc:
+        return (exc.strerror or str(exc)).lower()
+    finally:
+        if mask:
+            signal.pthread_sigmask(signal.SIG_UNBLOCK, held)
+    return None
+
+
+def make_parents(path: str | Path) -> None:
+    """
+    Create the missing parent directories of a bag destination.
+
+    Raises
+    ------
+    ScenarioError
+        If they cannot be made (a race with another process, a full disk).
+
+    """
+    try:
+        Path(path).parent.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise ScenarioError(f'cannot create the parent folder of {shown(str(path))}: '
+                            f'{exc.strerror or exc}') from None
 
 
 def default_bag_path(name: str, root: Path = Path('runs')) -> Path:
@@ -125,7 +195,7 @@ class BagRecorder:
         try:
             self._writer.open()
         except WriterError as exc:
-            raise ScenarioError(f'cannot create bag {str(self.path)!r}: {exc}') from None
+            raise ScenarioError(f'cannot create bag {shown(str(self.path))}: {exc}') from None
         self._open = True
         self._connections = [
             self._writer.add_connection(t.full_name(self._namespace), t.msgtype,

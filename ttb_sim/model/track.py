@@ -278,6 +278,47 @@ def approach_length(track: TrackParameters, train_length: float) -> float:
     return track.approach_length or (train_length + 20.0)
 
 
+@dataclass(frozen=True)
+class TrackExtent:
+    """Where the modelled track runs, known before it is built (m along the track)."""
+
+    rail_start: float
+    """First fastener: where the rails start."""
+    rail_end: float
+    """Last fastener: where the rails end."""
+    unit_start: float
+    """Start of the first slab / base unit."""
+    unit_end: float
+    """End of the last slab / base unit."""
+
+
+def track_extent(track: TrackParameters, bridge_length: float,
+                 train_length: float) -> TrackExtent:
+    """
+    Return the extent of the track :func:`build_track` would build, without building it.
+
+    Parameters
+    ----------
+    track : TrackParameters
+        Track keys of the scenario.
+    bridge_length : float
+        Total length of the girders (m).
+    train_length : float
+        Length of the train, for the automatic approach length (m).
+
+    """
+    approach = approach_length(track, train_length)
+    s, n_f = track.fastener_spacing, track.fasteners_per_slab
+    pitch = n_f * s
+    margin = 0.5 * (s - track.slab_gap)
+    x0 = -approach
+    n_units = int(math.ceil((bridge_length + 2.0 * approach) / pitch))
+    first = x0 + margin
+    last = x0 + (n_units - 1) * pitch + margin + (n_f - 1) * s
+    return TrackExtent(rail_start=first, rail_end=last, unit_start=x0,
+                       unit_end=x0 + (n_units - 1) * pitch + pitch - track.slab_gap)
+
+
 def build_track(track: TrackParameters, bridge_length: float, train_length: float,
                 first_node: int, girder: BeamLine) -> TrackMesh:
     """

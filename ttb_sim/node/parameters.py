@@ -41,6 +41,7 @@ from typing import Any, Mapping
 
 from ttb_sim.config import apply_overrides, from_mapping, key_spec, Scenario, Spec
 from ttb_sim.errors import ScenarioError
+from ttb_sim.inputs import shown
 from ttb_sim.io.bag import STORAGES
 
 DEFAULT_SCENARIO = 'moving_force_beam'
@@ -211,26 +212,26 @@ def validate_parameter(param: NodeParameter, value: Any, *,
                        f'node, e.g. --ros-args -p {name}:=...')
     if param.kind == 'bool':
         if not isinstance(value, bool):
-            return False, f'{name} = {value!r}: expected a bool, allowed {allowed}'
+            return False, f'{name} = {shown(value)}: expected a bool, allowed {allowed}'
         return True, ''
     if param.kind == 'string':
         if not isinstance(value, str):
-            return False, f'{name} = {value!r}: expected a string, allowed {allowed}'
+            return False, f'{name} = {shown(value)}: expected a string, allowed {allowed}'
         if param.spec.choices is not None and value not in param.spec.choices:
-            return False, f'{name} = {value!r} is not allowed: allowed {allowed}'
+            return False, f'{name} = {shown(value)} is not allowed: allowed {allowed}'
         if name == 'irregularity.file' and value and not Path(value).is_file():
-            return False, (f'{name} = {value!r}: no such file (allowed: a readable CSV '
+            return False, (f'{name} = {shown(value)}: no such file (allowed: a readable CSV '
                            "path, or '' to synthesise from the spectrum)")
         return True, ''
     if isinstance(value, bool) or not isinstance(value, (int, float)):
         kind = 'an integer' if param.kind == 'integer' else 'a number'
-        return False, f'{name} = {value!r}: expected {kind}, allowed {allowed}'
+        return False, f'{name} = {shown(value)}: expected {kind}, allowed {allowed}'
     if param.kind == 'integer' and isinstance(value, float) and not value.is_integer():
-        return False, f'{name} = {value!r}: expected an integer, allowed {allowed}'
+        return False, f'{name} = {shown(value)}: expected an integer, allowed {allowed}'
     if not math.isfinite(value):
-        return False, f'{name} = {value!r}: expected a finite number, allowed {allowed}'
+        return False, f'{name} = {shown(value)}: expected a finite number, allowed {allowed}'
     if not param.spec.contains(value):
-        return False, f'{name} = {value!r} is out of range: allowed {allowed}'
+        return False, f'{name} = {shown(value)} is out of range: allowed {allowed}'
     return True, ''
 
 
@@ -255,7 +256,7 @@ def validate_changes(table: Mapping[str, NodeParameter],
     for name, value in changes.items():
         param = table.get(name)
         if param is None:
-            return False, f'unknown parameter {name!r}; known: {", ".join(table)}'
+            return False, f'unknown parameter {shown(name)}; known: {", ".join(table)}'
         ok, reason = validate_parameter(param, value)
         if not ok:
             return ok, reason

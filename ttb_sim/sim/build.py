@@ -22,12 +22,13 @@ out of the scenario once and hands each model builder what it needs.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 
 import numpy as np
 
-from ttb_sim.config import Scenario
+from ttb_sim.config import car_layout, Scenario
 from ttb_sim.errors import ScenarioError
+from ttb_sim.inputs import shown
 from ttb_sim.model.bridge import assemble_structure, Structure
 from ttb_sim.model.irregularity import load_csv, synthesize, TrackIrregularity
 from ttb_sim.model.vehicle.train import Axles, MovingForces, MultibodyCars, QuarterCars, Vehicle
@@ -63,7 +64,7 @@ def build_vehicle(scenario: Scenario) -> Vehicle:
     axles = Axles(offsets=np.asarray(scenario.axle_positions(), dtype=float))
     n = axles.count
     if train.vehicle == 'car':
-        layout = replace(scenario, train=replace(train, axle_offsets=())).axle_positions()
+        layout = car_layout(train, scenario.car)
         return MultibodyCars(axles=Axles(offsets=np.asarray(layout, dtype=float)),
                              n_cars=train.n_cars, car_length=train.car_length)
     if train.vehicle == 'moving_force':
@@ -157,7 +158,7 @@ def observer_rows(scenario: Scenario, structure: Structure) -> tuple[np.ndarray,
     ftf = structure.full_to_free
     track = structure.track
     for i, obs in enumerate(observers):
-        where = f'output.observers[{i}] = {obs.name}={obs.component}@{obs.x:g}'
+        where = f'output.observers[{i}] = {shown(scenario.output.observers[i])}'
         if obs.component == 'girder':
             line = structure.girder_beam
         elif track is None:

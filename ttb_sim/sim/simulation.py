@@ -28,10 +28,11 @@ from typing import Iterator
 import numpy as np
 
 from ttb_sim.config import Scenario
-from ttb_sim.errors import DivergenceError, ModelError
+from ttb_sim.errors import DivergenceError, ModelError, ScenarioError
 from ttb_sim.model.bridge import bearing_forces
 from ttb_sim.sim.build import (build_coupling, build_structure, build_vehicle, observer_rows,
                                vehicle_track_setup)
+from ttb_sim.sim.cost import STEP_BUDGET
 from ttb_sim.sim.frames import Frame, Layout
 from ttb_sim.sim.integrators.newmark import Newmark
 from ttb_sim.sim.variants import blas_threads, solver_variant
@@ -42,6 +43,8 @@ STEPS_PER_PERIOD = 200
 """Automatic time step: steps per fundamental (or vehicle) period."""
 STEPS_PER_ELEMENT = 10
 """Automatic time step: steps for an axle to cross one girder element."""
+HARD_STEP_LIMIT = 1e12
+"""Most time steps any run may plan, even with no budget (a step count must stay countable)."""
 
 
 def nice_step(dt: float) -> float:
@@ -87,20 +90,33 @@ class Simulation:
     ----------
     scenario : Scenario
         A validated scenario.
+    max_steps : float or None
+        Step budget: a plan of more time steps is refused before the
+        integrator is built (None: no budget, as ``ttb-sim run --force``).
+
+    Raises
+    ------
+    ScenarioError
+        If the planned steps exceed ``max_steps`` (or cannot be counted at
+        all), naming solver.dt and solver.duration.
 
     """
 
-    def __init__(self, scenario: Scenario) -> None:
+    def __init__(self, scenario: Scenario, max_steps: float | None = STEP_BUDGET) -> None:
         self.scenario = scenario
         self.structure = build_structure(scenario)
         self.vehicle = build_vehicle(scenario)
         self._speed = scenario.train.speed
         st = self.structure
+        self.observers = observer_rows(scenario, st)
         limits, self.irregularity = vehicle_track_setup(scenario, st, self.vehicle)
         element, vf, max_step = limits.element_length, limits.vehicle_frequency, limits.max_step
         spacing = self.irregularity.dx if self.irregularity is not None else None
-        dt = scenario.solver.dt or auto_time_step(st.fundamental_frequency, element,
-                                                  self.speed, vf, spacing, max_step)
+        self.auto_dt = auto_time_step(st.fundamental_frequency, element, self.speed, vf,
+                                      spacing, max_step)
+        dt = scenario.solver.dt or self.auto_dt
+        self.duration = scenario.solver.duration or self.auto_duration()
+        self._check_plan(dt, max_steps)
         rate = scenario.output.rate_hz
         if rate > 0:
             period = 1.0 / rate
@@ -109,9 +125,7 @@ class Simulation:
         else:
             self.output_every = 1
         self.dt = dt
-        self.duration = scenario.solver.duration or self.auto_duration()
         self.n_steps = max(1, math.ceil(self.duration / dt - 1e-9))
-        self.observers = observer_rows(scenario, st)
         names = tuple(o.name for o in scenario.output.points)
         self.variant = solver_variant(scenario.solver.variant)
         with blas_threads(self.variant.blas_threads):
@@ -125,6 +139,31 @@ class Simulation:
                              observers=names)
         log.info('model: %d free DOFs, %d axles, dt = %.3g s, %d steps', st.n_free,
                  self.vehicle.axles.count, dt, self.n_steps)
+
+    def _check_plan(self, dt: float, max_steps: float | None) -> None:
+        """Refuse a plan over the step budget; warn about a step above the accuracy rule."""
+        solver = self.scenario.solver
+        steps = self.duration / dt
+        dt_text = (f'solver.dt = {dt:.3g} s' if solver.dt
+                   else f'dt = {dt:.3g} s (automatic)')
+        duration_text = (f'solver.duration = {self.duration:.6g} s' if solver.duration
+                         else f'solver.duration = 0 (automatic: {self.duration:.6g} s)')
+        limit = HARD_STEP_LIMIT if max_steps is None else min(max_steps, HARD_STEP_LIMIT)
+        if not steps <= limit:
+            hint = '' if max_steps is None or max_steps >= HARD_STEP_LIMIT else (
+                ', or pass --force to run it anyway')
+            raise ScenarioError(
+                f'{duration_text} at {dt_text} plans {steps:.3g} time steps, over the '
+                f'budget of {limit:.3g}: raise solver.dt, set a shorter solver.duration'
+                f'{hint}')
+        period = 1.0 / self.structure.fundamental_frequency
+        accurate = period / STEPS_PER_PERIOD
+        if solver.dt and solver.dt > accurate * (1.0 + 1e-9):
+            log.warning('solver.dt = %.3g s exceeds the accuracy rule T1/%d = %.3g s (T1 = '
+                        '%.3g s, first bending period of a span): the Newmark period error '
+                        'grows as dt^2 (0.008 %% at T1/200, %.2g %% here); the automatic '
+                        'step would be %.3g s', solver.dt, STEPS_PER_PERIOD, accurate, period,
+                        0.008 * (solver.dt / accurate) ** 2, self.auto_dt)
 
     @property
     def speed(self) -> float:

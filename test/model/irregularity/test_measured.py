@@ -114,12 +114,15 @@ def test_csv_refusals_name_file_and_row(tmp_path, lines, kwargs, message):
 
 def test_csv_unreadable_file_is_refused(tmp_path):
     """A missing file, a directory and a binary file are refused naming the path."""
-    for path in (tmp_path / 'missing.csv', tmp_path):
-        with pytest.raises(ScenarioError, match=f'{path}: cannot read irregularity file'):
-            measured.load_csv(path)
+    with pytest.raises(ScenarioError, match=r"irregularity file '.*missing.csv' does not "
+                       'exist'):
+        measured.load_csv(tmp_path / 'missing.csv')
+    with pytest.raises(ScenarioError, match=r'irregularity file .* is a directory, not a file'):
+        measured.load_csv(tmp_path)
     binary = tmp_path / 'binary.csv'
     binary.write_bytes(b'\xff\xfe\x00\x81' * 10)
-    with pytest.raises(ScenarioError, match='binary.csv: cannot read'):
+    with pytest.raises(ScenarioError, match=r"cannot read irregularity file '.*binary.csv': "
+                       'not utf-8-sig text'):
         measured.load_csv(binary)
 
 
@@ -131,3 +134,40 @@ def test_csv_skips_comments_and_blank_lines(tmp_path):
     prof = measured.load_csv(path, min_length=2.0)
     assert prof.n_points == 5 and prof.dx == 0.5
     assert prof.z_left[1] == 1e-3
+
+
+def test_a_headerless_five_column_csv_is_read_as_x_z_left_z_right_y_left_y_right(tmp_path):
+    """Without a header the five columns are taken in the documented order, values exact."""
+    plain = tmp_path / 'plain.csv'
+    plain.write_text('\n'.join(['# measured', *GOOD_ROWS]) + '\n')
+    named = tmp_path / 'named.csv'
+    named.write_text('\n'.join(['x,z_left,z_right,y_left,y_right', *GOOD_ROWS]) + '\n')
+    a, b = measured.load_csv(plain), measured.load_csv(named)
+    np.testing.assert_array_equal(a.values, b.values)
+    assert a.x_start == b.x_start and a.dx == b.dx
+
+
+@pytest.mark.parametrize('first, found', [('0.0,0,0,0', 4), ('0.0,0,0,0,0,7', 6)])
+def test_a_headerless_csv_needs_exactly_five_columns(tmp_path, first, found):
+    path = tmp_path / 'short.csv'
+    path.write_text('\n'.join([first, *GOOD_ROWS]) + '\n')
+    with pytest.raises(ScenarioError, match=r'short.csv: row 1: the first row is numbers, so '
+                       r'the file has no header: a headerless file needs exactly 5 columns '
+                       rf'\(x, z_left, z_right, y_left, y_right, in that order\), found {found}'):
+        measured.load_csv(path)
+
+
+def test_a_csv_field_over_the_csv_limit_is_refused(tmp_path):
+    path = tmp_path / 'long.csv'
+    path.write_text('x,z_left,z_right,y_left,y_right\n"' + 'a' * 200_000 + '",0,0,0,0\n')
+    with pytest.raises(ScenarioError, match='long.csv: cannot parse as CSV'):
+        measured.load_csv(path)
+
+
+def test_a_long_extra_column_does_not_blow_up_memory(tmp_path):
+    """Ignored columns are never put in a fixed-width array (a 100 kB note would be 400 kB)."""
+    path = tmp_path / 'note.csv'
+    rows = [f'{r},note' for r in GOOD_ROWS]
+    rows[0] += 'x' * 100_000
+    path.write_text('\n'.join(['x,z_left,z_right,y_left,y_right,note', *rows]) + '\n')
+    assert measured.load_csv(path).n_points == len(GOOD_ROWS)

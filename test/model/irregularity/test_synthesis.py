@@ -24,7 +24,6 @@ The PSDs themselves are checked against the PHYSICS.md formulas in
 from __future__ import annotations
 
 import math
-import time
 
 import numpy as np
 import pytest
@@ -203,11 +202,14 @@ def test_scale_multiplies_amplitudes_and_zero_is_smooth():
     np.testing.assert_allclose(two.curvatures, 2.0 * one.curvatures, rtol=1e-12, atol=0.0)
 
 
-def test_three_km_paper_track_is_fast():
-    """3 km at 0.01 m (300 001 points, paper preset) synthesises in < 2 s (measured 0.15 s)."""
-    start = time.perf_counter()
+def test_three_km_paper_track_has_every_point():
+    """
+    3 km at 0.01 m (paper preset) gives 300 001 points ending at 3000 m.
+
+    No wall-time assertion: speed is measured by ``ttb-sim bench``, never by a
+    test (a loaded CI machine must not fail the suite).
+    """
     prof = synthesis.synthesize('paper', length=3000.0, dx=0.01, seed=0)
-    assert time.perf_counter() - start < 2.0
     assert prof.n_points == 300_001
     assert prof.x_end == pytest.approx(3000.0)
 

@@ -17,7 +17,8 @@ Measured rail irregularity profiles: CSV read (:func:`load_csv`) and write.
 
 The file has a header row naming at least :data:`CSV_COLUMNS` (x along the
 track, then the rail irregularities with the signs of :mod:`.profile`), one
-row per position.  A refused user file raises
+row per position; a file without a header must have exactly those five
+numeric columns, in that order.  A refused user file raises
 :class:`~ttb_sim.errors.ScenarioError` naming the file and the row; a bad
 argument (``dx``) raises :class:`~ttb_sim.errors.ModelError`.
 """
@@ -29,17 +30,19 @@ import logging
 import math
 import operator
 from os import PathLike
-from pathlib import Path
 
 import numpy as np
 from scipy.interpolate import CubicSpline
 
 from ttb_sim.errors import ScenarioError
+from ttb_sim.inputs import MAX_SHOWN, read_user_file, shown
 from ttb_sim.model.irregularity._checks import check_positive, GRID_SLACK
 from ttb_sim.model.irregularity.profile import RAIL_QUANTITIES, TrackIrregularity
 
 __all__ = [
     'CSV_COLUMNS',
+    'MAX_CSV_BYTES',
+    'MAX_GRID_POINTS',
     'MIN_CSV_ROWS',
     'load_csv',
     'save_csv',
@@ -52,6 +55,15 @@ CSV_COLUMNS: tuple[str, ...] = ('x', *RAIL_QUANTITIES)
 
 #: Fewest data rows accepted from a CSV (a cubic spline needs four).
 MIN_CSV_ROWS: int = 4
+
+#: Largest irregularity CSV read (bytes): 3 km at 1 cm is about 20 MB.
+MAX_CSV_BYTES: int = 64 << 20
+
+#: Longest numeric cell read (characters); longer ones are refused as non-numeric.
+MAX_CELL_CHARS: int = 100
+
+#: Most points of a resampled profile (10 km at 1 mm).
+MAX_GRID_POINTS: int = 10_000_000
 
 
 def save_csv(irregularity: TrackIrregularity, path: str | PathLike[str]) -> None:
@@ -80,7 +92,8 @@ def save_csv(irregularity: TrackIrregularity, path: str | PathLike[str]) -> None
 
 
 def _refuse(path: str | PathLike[str], row: int | None, problem: str) -> ScenarioError:
-    where = f'{path}' if row is None else f'{path}: row {row}'
+    name = shown(str(path)) if len(str(path)) > MAX_SHOWN else str(path)
+    where = name if row is None else f'{name}: row {row}'
     return ScenarioError(f'{where}: {problem}')
 
 
@@ -95,8 +108,10 @@ def load_csv(
 
     The file has a header row naming at least the columns ``x, z_left,
     z_right, y_left, y_right`` (any order; other columns are ignored), then one
-    row per position: x along the track (m, strictly increasing) and the rail
-    irregularities (m, signs as in :mod:`.profile`).  Blank lines and
+    row per position; or no header, when its first row is all numbers, and then
+    exactly these five columns in this order. Each row holds x along the
+    track (m, strictly increasing) and the rail irregularities (m, signs as
+    in :mod:`.profile`).  Blank lines and
     lines starting with ``#`` are skipped.  Row numbers in messages are line
     numbers of the file, counting from 1 (the header is usually row 1).
 
@@ -133,32 +148,44 @@ def load_csv(
         If ``dx`` is given and is not a finite number > 0.
 
     """
-    try:
-        text = Path(path).read_text(encoding='utf-8-sig')
-    except (OSError, UnicodeDecodeError) as exc:
-        raise _refuse(path, None, f'cannot read irregularity file ({exc})') from None
+    text = read_user_file(path, 'irregularity file', MAX_CSV_BYTES, encoding='utf-8-sig')
     lines = text.splitlines()
-    rows = list(csv.reader(lines))
+    try:
+        rows = list(csv.reader(lines))
+    except csv.Error as exc:  # e.g. a field over the csv module's size limit
+        raise _refuse(path, None, f'cannot parse as CSV ({shown(str(exc))[1:-1]})') from None
     if len(rows) != len(lines):   # a quoted field spanning lines
         raise _refuse(path, None, 'unbalanced quotes; cannot parse as CSV')
-    stripped = np.char.strip(np.array(lines, dtype=str)) if lines else np.array([], dtype=str)
-    content = np.flatnonzero((stripped != '') & ~np.char.startswith(stripped, '#'))
+    content = np.array([i for i, line in enumerate(lines)
+                        if line.strip() and not line.strip().startswith('#')], dtype=np.intp)
     if content.size == 0:
-        raise _refuse(path, 1, f'no header; expected columns {", ".join(CSV_COLUMNS)}')
+        raise _refuse(path, 1, f'no header and no data rows; expected a header row naming '
+                      f'the columns {", ".join(CSV_COLUMNS)} (or no header and exactly five '
+                      'numeric columns in that order)')
 
     header_index = int(content[0])
     header = [name.strip() for name in rows[header_index]]
-    missing = [name for name in CSV_COLUMNS if name not in header]
-    if missing:
-        message = (
-            f'header is missing column(s) {", ".join(missing)}; '
-            f'expected {", ".join(CSV_COLUMNS)}, found {", ".join(header)}')
-        raise _refuse(path, header_index + 1, message)
-    duplicated = sorted({name for name in CSV_COLUMNS if header.count(name) > 1})
-    if duplicated:
-        raise _refuse(path, header_index + 1, f'duplicated column(s) {", ".join(duplicated)}')
-
-    data_index = content[1:]
+    if header and all(_parses_as_float(name) for name in header):  # no header: numbers
+        if len(header) != len(CSV_COLUMNS):
+            message = (f'the first row is numbers, so the file has no header: a headerless '
+                       f'file needs exactly {len(CSV_COLUMNS)} columns '
+                       f'({", ".join(CSV_COLUMNS)}, in that order), found {len(header)}; '
+                       'or add a header row naming the columns')
+            raise _refuse(path, header_index + 1, message)
+        header = list(CSV_COLUMNS)
+        data_index = content
+    else:
+        missing = [name for name in CSV_COLUMNS if name not in header]
+        if missing:
+            message = (
+                f'header is missing column(s) {", ".join(missing)}; '
+                f'expected {", ".join(CSV_COLUMNS)}, found {shown(", ".join(header))}')
+            raise _refuse(path, header_index + 1, message)
+        duplicated = sorted({name for name in CSV_COLUMNS if header.count(name) > 1})
+        if duplicated:
+            raise _refuse(path, header_index + 1,
+                          f'duplicated column(s) {", ".join(duplicated)}')
+        data_index = content[1:]
     row_numbers = data_index + 1
     if data_index.size < MIN_CSV_ROWS:
         last = f'last data row {row_numbers[-1]}' if data_index.size else 'no data rows'
@@ -173,24 +200,33 @@ def load_csv(
         r = wrong[0]
         message = f'expected {len(header)} fields as in the header, found {widths[r]}'
         raise _refuse(path, int(row_numbers[r]), message)
-    table = np.array(operator.itemgetter(*data_index)(rows), dtype=str)
-    cells = np.char.strip(table[:, [header.index(name) for name in CSV_COLUMNS]])
+    columns = [header.index(name) for name in CSV_COLUMNS]
+    data_rows = operator.itemgetter(*data_index)(rows)
+    selected = [[row[j].strip() for j in columns] for row in data_rows]
+    for r, row_cells in enumerate(selected):  # bound the fixed-width array below
+        for c, cell in enumerate(row_cells):
+            if len(cell) > MAX_CELL_CHARS:
+                message = f'non-numeric value {shown(cell)} in column {CSV_COLUMNS[c]}'
+                raise _refuse(path, int(row_numbers[r]), message)
+    cells = np.array(selected, dtype=str)
     try:
         numbers = cells.astype(np.float64)
     except ValueError:
         parsed = np.asarray(np.frompyfunc(_parses_as_float, 1, 1)(cells)).astype(bool)
         r, c = np.argwhere(~parsed)[0]
-        message = f'non-numeric value {str(cells[r, c])!r} in column {CSV_COLUMNS[c]}'
+        message = f'non-numeric value {shown(str(cells[r, c]))} in column {CSV_COLUMNS[c]}'
         raise _refuse(path, int(row_numbers[r]), message) from None
     bad = np.argwhere(~np.isfinite(numbers))
     if bad.size:
         r, c = bad[0]
-        message = f'value {str(cells[r, c])!r} in column {CSV_COLUMNS[c]} is not a finite number'
+        message = (f'value {shown(str(cells[r, c]))} in column {CSV_COLUMNS[c]} is not a finite '
+                   'number')
         raise _refuse(path, int(row_numbers[r]), message)
 
     x = numbers[:, 0]
     rails = numbers[:, 1:].T
-    steps = np.diff(x)
+    with np.errstate(over='ignore', invalid='ignore'):  # a span over 1.8e308 m: refused below
+        steps = np.diff(x)
     decreasing = np.flatnonzero(steps <= 0.0)
     if decreasing.size:
         r = decreasing[0] + 1
@@ -198,7 +234,8 @@ def load_csv(
             f'x = {x[r]:g} m does not increase strictly (previous data row {row_numbers[r - 1]} '
             f'has x = {x[r - 1]:g} m)')
         raise _refuse(path, int(row_numbers[r]), message)
-    covered = x[-1] - x[0]
+    with np.errstate(over='ignore'):
+        covered = float(x[-1] - x[0])
     if min_length is not None and covered < float(min_length) * (1.0 - GRID_SLACK):
         message = (
             f'profile too short: it covers {covered:g} m (x = {x[0]:g} to {x[-1]:g} m, last '
@@ -206,6 +243,9 @@ def load_csv(
         raise _refuse(path, int(row_numbers[-1]), message)
 
     spacing = float(np.median(steps))
+    if not (math.isfinite(covered) and spacing > 0.0 and math.isfinite(spacing)):
+        raise _refuse(path, None, f'x spans {covered:g} m with a median spacing of {spacing:g} m; '
+                      'both must be finite and > 0')
     uniform = bool(np.max(np.abs(steps - spacing)) <= 1e-6 * spacing)
     spline = CubicSpline(x, rails, axis=1)
     if dx is None and uniform:
@@ -214,6 +254,12 @@ def load_csv(
         grid = x
     else:
         grid_dx = spacing if dx is None else check_positive('dx', dx)
+        n_grid = covered / grid_dx
+        if n_grid > MAX_GRID_POINTS:
+            raise _refuse(path, None, f'resampling {covered:g} m at dx = {grid_dx:g} m (the '
+                          f'{"median row spacing" if dx is None else "grid spacing"}) gives '
+                          f'{n_grid:.3g} points, over the limit of {MAX_GRID_POINTS}; give '
+                          'uniformly spaced rows or fewer, wider-spaced ones')
         grid = x[0] + grid_dx * np.arange(int(math.floor(covered / grid_dx + GRID_SLACK)) + 1)
         if grid.size < 2:
             raise _refuse(path, None, f'dx = {grid_dx:g} m is longer than the profile')

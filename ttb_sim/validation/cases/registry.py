@@ -22,7 +22,8 @@ and compares with an independent reference from :mod:`ttb_sim.validation.referen
 from __future__ import annotations
 
 import math
-from typing import Sequence
+import time
+from typing import Callable, Sequence
 
 import numpy as np
 import scipy.sparse as sp
@@ -170,11 +171,31 @@ CASES: dict[str, Case] = {c.case_id: c for c in sorted((
 """Cases by id: V* are VALIDATION.md's, X* are extra checks of modelling choices."""
 
 
-def run_cases(case_ids: Sequence[str]) -> list[Row]:
-    """Run the named cases and return all their rows."""
+def run_cases(case_ids: Sequence[str],
+              progress: Callable[[int, int, str, list[Row] | None, float], None] | None = None
+              ) -> list[Row]:
+    """
+    Run the named cases and return all their rows.
+
+    Parameters
+    ----------
+    case_ids : sequence of str
+        Case ids, run in this order.
+    progress : callable, optional
+        Called before each case as ``progress(i, n, case_id, None, 0.0)`` and
+        after it as ``progress(i, n, case_id, rows, seconds)`` (i from 1).
+
+    """
     rows: list[Row] = []
-    for case_id in case_ids:
-        rows.extend(CASES[case_id].run())
+    n = len(case_ids)
+    for i, case_id in enumerate(case_ids, start=1):
+        if progress is not None:
+            progress(i, n, case_id, None, 0.0)
+        start = time.perf_counter()
+        case_rows = CASES[case_id].run()
+        rows.extend(case_rows)
+        if progress is not None:
+            progress(i, n, case_id, case_rows, time.perf_counter() - start)
     return rows
 
 

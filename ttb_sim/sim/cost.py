@@ -1,0 +1,134 @@
+# Copyright 2026 The ttb_sim Authors
+#
+# Licensed under the Apache License, Version 2.0 (the "License");
+# you may not use this file except in compliance with the License.
+# You may obtain a copy of the License at
+#
+#     http://www.apache.org/licenses/LICENSE-2.0
+#
+# Unless required by applicable law or agreed to in writing, software
+# distributed under the License is distributed on an "AS IS" BASIS,
+# WITHOUT WARRANTIES OR CONDITIONS OF ANY KIND, either express or implied.
+# See the License for the specific language governing permissions and
+# limitations under the License.
+
+"""
+What a run will cost, told before it starts: steps, DOFs, frames and a wall-time estimate.
+
+The estimate is a model, not a measurement: wall time = fixed overhead + steps x
+per-step cost + messages x per-message cost. The per-step cost grows with the
+free DOFs of the structure (sparse triangular solves) and with the multibody
+cars (wheel-rail contact), times a factor for the solver variant; the
+per-message cost is the bag writer's. The constants were fitted to
+``ttb-sim run`` on the project's 2-core machine under load (moving_force_beam,
+sprung_mass_beam, ten_span_train, track_approach, paper_ttbi with qdldl;
+README, Benchmark, for the variant factors): expect the real time within a
+factor of about 2 either way, more on a very different machine.
+``ttb-sim bench`` measures the real numbers.
+"""
+
+from __future__ import annotations
+
+from dataclasses import asdict, dataclass
+from typing import Any
+
+__all__ = ['CostEstimate', 'estimate_cost', 'STEP_BUDGET']
+
+STEP_BUDGET = 20_000_000
+"""Most time steps a run may plan without ``--force`` (about 1-10 h of wall time)."""
+
+OVERHEAD_S = 0.3
+"""Opening and closing the bag, first-step set-up (s)."""
+STEP_BASE_MS = 0.05
+"""Per-step cost independent of the model size (ms)."""
+STEP_PER_DOF_MS = 2.0e-4
+"""Per-step cost per free structural DOF (ms)."""
+CONTACT_BASE_MS = 3.0
+"""Per-step cost of wheel-rail contact for the first multibody car (ms)."""
+CONTACT_PER_CAR_MS = 0.9
+"""Per-step cost of wheel-rail contact per multibody car (ms)."""
+MESSAGE_MS = 0.08
+"""Cost of writing one message to the bag (ms)."""
+VARIANT_FACTOR = {'qdldl': 1.0, 'cholmod': 1.0, 'superlu_sym': 1.8, 'reference': 3.5}
+"""Per-step cost of each solver variant relative to qdldl (README, Benchmark)."""
+
+
+@dataclass(frozen=True)
+class CostEstimate:
+    """The planned work of one run and its estimated wall time."""
+
+    steps: int
+    """Time steps planned."""
+    dt: float
+    """Time step (s)."""
+    duration: float
+    """Simulated time (s)."""
+    free_dofs: int
+    """Free DOFs of the structure."""
+    cars: int
+    """Multibody cars (0 for moving forces and quarter cars)."""
+    frames: int
+    """Frames written."""
+    messages: int
+    """Messages written (frames x topics)."""
+    per_step_ms: float
+    """Estimated cost of one step (ms)."""
+    wall_time: float
+    """Estimated wall time of the stepping and writing (s), set-up not included."""
+
+    def as_dict(self) -> dict[str, Any]:
+        """Return the estimate as plain data (for ``summary.json``)."""
+        return asdict(self)
+
+    def describe(self) -> str:
+        """Return one line for the user: the plan and the estimated time."""
+        return (f'{self.steps} steps of {self.dt:.3g} s ({self.duration:.4g} s simulated), '
+                f'{self.free_dofs} free DOFs, {self.frames} frames x '
+                f'{self.messages // max(self.frames, 1)} topics; estimated '
+                f'{_duration(self.wall_time)} (a model: within about 2x)')
+
+
+def estimate_cost(*, steps: int, dt: float, free_dofs: int, cars: int, frames: int,
+                  messages_per_frame: int, variant: str) -> CostEstimate:
+    """
+    Estimate the wall time of a planned run.
+
+    Parameters
+    ----------
+    steps : int
+        Time steps planned.
+    dt : float
+        Time step (s).
+    free_dofs : int
+        Free DOFs of the structure.
+    cars : int
+        Multibody cars on wheel-rail contact.
+    frames : int
+        Frames to write.
+    messages_per_frame : int
+        Messages per frame (topics).
+    variant : str
+        ``solver.variant``.
+
+    Returns
+    -------
+    CostEstimate
+
+    """
+    per_step = STEP_BASE_MS + STEP_PER_DOF_MS * free_dofs
+    per_step *= VARIANT_FACTOR.get(variant, 1.0)
+    if cars:
+        per_step += CONTACT_BASE_MS + CONTACT_PER_CAR_MS * (cars - 1)
+    messages = frames * messages_per_frame
+    wall = OVERHEAD_S + (steps * per_step + messages * MESSAGE_MS) / 1000.0
+    return CostEstimate(steps=steps, dt=dt, duration=steps * dt, free_dofs=free_dofs,
+                        cars=cars, frames=frames, messages=messages, per_step_ms=per_step,
+                        wall_time=wall)
+
+
+def _duration(seconds: float) -> str:
+    if seconds < 120.0:
+        return f'{seconds:.2g} s'
+    if seconds < 7200.0:
+        return f'{seconds / 60.0:.3g} min'
+    return f'{seconds / 3600.0:.3g} h'
