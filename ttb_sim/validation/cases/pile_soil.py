@@ -346,8 +346,8 @@ PILE_SOIL_CASES = (
     Case('V11', 'homogeneous soil column on a rigid base: first resonance', v11),
     Case('V12', "[P]'s three-layer deposit: second shear-column mode", v12),
     Case('V13', 'viscous-spring boundary: energy reflected by the base', v13),
-    Case('V14', 'single pile: static head stiffness vs Randolph-Wroth', v14),
-    Case('V15', "[P]'s 10 kN 20 Hz check on pile 5: amplitudes, transient", v15),
+    Case('V14', 'single pile: static head stiffness vs Randolph-Wroth (about 1 min)', v14),
+    Case('V15', "[P]'s 10 kN 20 Hz check on pile 5: amplitudes, transient (about 17 min)", v15),
     Case('V16', 'Desai interface under monotonic shear', v16),
 )
 """The pile-soil cases, registered with the validation suite."""
