@@ -53,7 +53,7 @@ setup(
     tests_require=['pytest'],
     entry_points={
         'console_scripts': [
-            'ttb-sim = ttb_sim.cli:main',
+            'ttb-sim = ttb_sim.cli:entry',
             'simulator = ttb_sim.simulator_node:main',
         ],
     },

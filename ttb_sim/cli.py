@@ -107,6 +107,21 @@ def main(argv: Sequence[str] | None = None) -> int:
             signal.signal(sig, handler)
 
 
+def entry() -> None:
+    """
+    Run ``ttb-sim`` as a program (the console script and ``python -m ttb_sim.cli``).
+
+    Unlike :func:`main`, the one-line SIGINT / SIGTERM handler stays installed until
+    the process exits, so a signal that arrives after the verb has finished (its
+    output is complete) still ends in one line and exit 128 + signal, never in a
+    ``KeyboardInterrupt`` traceback during shutdown.
+    """
+    if threading.current_thread() is threading.main_thread():
+        for sig in (signal.SIGINT, signal.SIGTERM):
+            signal.signal(sig, _stop_now)
+    sys.exit(_main(sys.argv[1:]))
+
+
 def _main(argv: Sequence[str] | None) -> int:
     parser = _parser()
     args = parser.parse_args(argv)
@@ -144,4 +159,4 @@ def _main(argv: Sequence[str] | None) -> int:
 
 
 if __name__ == '__main__':  # pragma: no cover
-    sys.exit(main())
+    entry()

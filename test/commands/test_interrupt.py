@@ -125,3 +125,19 @@ def test_missing_parents_are_made(tmp_path: Path, capsys) -> None:
     assert summary['wall_time'] == pytest.approx(summary['setup_time']
                                                  + summary['stepping_time'])
     assert summary['setup_time'] > 0.0
+
+
+def test_the_program_keeps_its_one_line_handler_until_it_exits(tmp_path: Path) -> None:
+    """A signal after the verb has finished still ends in one line, not a traceback."""
+    code = ('import atexit, signal, sys\n'
+            'atexit.register(lambda: print("handler", signal.getsignal(signal.SIGINT).__name__,'
+            ' file=sys.stderr))\n'
+            'sys.argv = ["ttb-sim", "scenarios"]\n'
+            'from ttb_sim.cli import entry\n'
+            'entry()\n')
+    env = {**os.environ, 'PYTHONPATH': os.pathsep.join(
+        [str(ROOT), os.environ.get('PYTHONPATH', '')])}
+    done = subprocess.run([sys.executable, '-c', code], capture_output=True, text=True,
+                          env=env, timeout=HANG_BOUND, check=False)
+    assert done.returncode == 0, done.stderr
+    assert 'handler _stop_now' in done.stderr
