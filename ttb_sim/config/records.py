@@ -220,13 +220,11 @@ MAX_MODEL_NODES = 200_000
 def model_nodes(s: Scenario) -> int:
     """Count the beam nodes the model of a scenario will have, before building it."""
     nodes = s.bridge.n_spans * (s.bridge.elements_per_span + 1)
-    if s.bridge.n_spans > 1:
+    if s.foundation.model == 'springs':
         nodes += (s.bridge.n_spans - 1) * (s.piers.elements + 1)
     if s.track.model == 'slab':
         t = s.track
-        approach = t.approach_length or (s.train.n_cars * s.train.car_length + 20.0)
-        pitch = t.fasteners_per_slab * t.fastener_spacing
-        units = math.ceil((_bridge_length(s) + 2.0 * approach) / pitch)
+        units = _extent(s).n_units
         fasteners = units * t.fasteners_per_slab
         nodes += 2 * ((fasteners - 1) * t.rail_elements_per_bay + 1)
         nodes += 2 * units * (t.fasteners_per_slab + 2)

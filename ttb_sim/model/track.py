@@ -290,6 +290,8 @@ class TrackExtent:
     """Start of the first slab / base unit."""
     unit_end: float
     """End of the last slab / base unit."""
+    n_units: int
+    """Number of slab / base units."""
 
 
 def track_extent(track: TrackParameters, bridge_length: float,
@@ -316,7 +318,8 @@ def track_extent(track: TrackParameters, bridge_length: float,
     first = x0 + margin
     last = x0 + (n_units - 1) * pitch + margin + (n_f - 1) * s
     return TrackExtent(rail_start=first, rail_end=last, unit_start=x0,
-                       unit_end=x0 + (n_units - 1) * pitch + pitch - track.slab_gap)
+                       unit_end=x0 + (n_units - 1) * pitch + pitch - track.slab_gap,
+                       n_units=n_units)
 
 
 def build_track(track: TrackParameters, bridge_length: float, train_length: float,
