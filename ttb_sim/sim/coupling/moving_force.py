@@ -57,6 +57,8 @@ class MovingForceCoupling:
         self.u = np.zeros(n_free)
         self.v = np.zeros(n_free)
         self.a = np.zeros(n_free)
+        self._no_vehicle = VehicleOutputs(np.zeros((0, 3)), np.zeros((0, 3)),
+                                          np.zeros((0, 1, 2, 3)))
         self._lean = (MovingLoad(structure.girder, forces.loads, n_free, structure.n_full)
                       if lean else None)
 
@@ -99,4 +101,4 @@ class MovingForceCoupling:
 
     def vehicle_outputs(self) -> VehicleOutputs:
         """Return empty vehicle outputs (moving forces have no bodies)."""
-        return VehicleOutputs(np.zeros((0, 3)), np.zeros((0, 3)), np.zeros((0, 1, 2, 3)))
+        return self._no_vehicle

@@ -211,6 +211,7 @@ class TrainTrackCoupling:
         ftf = structure.full_to_free
         self.rail_dofs = tuple(ftf[r.dofs] for r in self.rails)
         self.compliance = RailCompliance(integrator, self.rails, ftf)
+        self._no_load = np.zeros(structure.n_full)   # read-only, shared by every frame
         self._speed = math.nan
         self.tol = cc.tolerance
         self.max_iter = cc.max_iterations
@@ -581,7 +582,7 @@ class TrainTrackCoupling:
 
     def structure_load(self, head: float) -> np.ndarray:
         """Return zero: the wheel loads act through the rails, not on the girder DOFs."""
-        return np.zeros(self.structure.n_full)
+        return self._no_load
 
     def monitored(self) -> tuple[np.ndarray, ...]:
         """Return the track-bridge and car displacements."""
