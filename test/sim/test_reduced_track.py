@@ -23,7 +23,8 @@ import scipy.sparse.linalg as sla
 from ttb_sim.config import load_scenario
 from ttb_sim.sim import reduced_track
 from ttb_sim.sim.build import build_structure
-from ttb_sim.sim.reduced_track import project, static_track_basis, track_window
+from ttb_sim.sim.reduced_track import (project, rigid_track_basis, static_track_basis,
+                                       track_window)
 from ttb_sim.sim.simulation import Simulation
 
 SMALL = [('train.vehicle', 'car'), ('track.model', 'slab'), ('train.n_cars', 1),
@@ -34,10 +35,10 @@ SMALL = [('train.vehicle', 'car'), ('track.model', 'slab'), ('train.n_cars', 1),
 
 @pytest.fixture(scope='module')
 def small():
-    """The structure, its static track basis and a window over the second span."""
+    """Return the structure and a window over the second span."""
     structure = build_structure(load_scenario('moving_force_beam', values=SMALL))
     static = static_track_basis(structure, 'qdldl')
-    window = track_window(structure, static, 30.0, 70.0)
+    window = track_window(structure, static, rigid_track_basis(structure), 30.0, 70.0)
     return structure, window
 
 
@@ -45,6 +46,19 @@ def test_basis_keeps_the_bridge_and_the_window_and_rests_the_rest_on_it(small):
     st, window = small
     t = window.basis.tocsr()
     assert 0 < window.size < st.n_free
+    # The local basis moves every far track node with the girder below it: a rigid
+    # vertical translation of the girders lifts the far track on the bridge alike.
+    local = window.local_basis
+    girder_z = st.full_to_free[st.girder_beam.dofs[:, [2, 8]]].ravel()
+    lift = np.zeros(window.size)
+    lift[np.searchsorted(window.kept, girder_z[girder_z < st.n_free])] = 1.0
+    moved = local @ lift
+    rail = st.track.rails[0]
+    far_on_bridge = (((rail.start > 1.0) & (rail.start < window.start - 1.0))
+                     | ((rail.start > window.end + 1.0) & (rail.start < st.girder_beam.end - 1.0)))
+    assert np.count_nonzero(far_on_bridge) > 100
+    rail_z = st.full_to_free[rail.dofs[far_on_bridge, 2]]
+    np.testing.assert_allclose(moved[rail_z], 1.0, rtol=1e-12)
     # Kept DOFs are identity rows of T.
     kept_rows = t[window.kept]
     assert np.array_equal(kept_rows.indices, np.arange(window.size))
@@ -73,16 +87,23 @@ def test_reduced_statics_equal_the_full_model(small):
 
 
 def test_reduced_low_frequencies_equal_the_full_model(small):
-    """The far track rides on the bridge as Guyan mass: bridge modes within 0.05 %."""
+    """
+    Far track as static stiffness and rigidly carried mass: bridge modes within 0.5 %.
+
+    Measured: at most 0.24 % over the lowest eight modes (3.6-7.5 Hz) here, where
+    the far track is 60 % of the bridge's; 0.04 % over the lowest twelve of
+    paper_ttbi. Riding rigidly in the stiffness too made a span 46 % stiffer
+    (the track's plates locked the span joints).
+    """
     st, window = small
-    t = window.basis
     full = sla.eigsh(st.stiffness.tocsc(), k=8, M=st.mass.tocsc(), sigma=0.0,
                      return_eigenvectors=False)
-    red = sla.eigsh(project(st.stiffness, t).tocsc(), k=8, M=project(st.mass, t).tocsc(),
-                    sigma=0.0, return_eigenvectors=False)
+    red = sla.eigsh(project(st.stiffness, window.basis).tocsc(), k=8,
+                    M=project(st.mass, window.local_basis).tocsc(), sigma=0.0,
+                    return_eigenvectors=False)
     f_full, f_red = (np.sort(np.sqrt(v)) / (2 * np.pi) for v in (full, red))
     assert f_full[0] > 1.0
-    np.testing.assert_allclose(f_red, f_full, rtol=5e-4)
+    np.testing.assert_allclose(f_red, f_full, rtol=5e-3)
 
 
 def test_reduced_run_with_moving_window_follows_the_full_model(monkeypatch):

@@ -30,17 +30,29 @@ import numpy as np
 
 log = logging.getLogger(__name__)
 
-try:  # numba is optional: without it the numpy twins run.
-    import numba
-except ImportError:  # pragma: no cover - depends on the installation
-    numba = None
+ENABLED = True
+"""False makes :func:`compiled` return None, so the lean step takes the numpy twins."""
+_CACHE: dict[str, Callable[..., Any] | None] = {}
 
 
-def _jit(function: Callable[..., Any]) -> Callable[..., Any] | None:
-    """Return the compiled function, or None without numba."""
-    if numba is None:  # pragma: no cover - depends on the installation
+def compiled(name: str) -> Callable[..., Any] | None:
+    """
+    Return the compiled kernel ``name`` (compiled on first call), or None.
+
+    None when numba is not installed or :data:`ENABLED` is False; numba is
+    imported only here, so the package imports without it and quickly.
+    """
+    if not ENABLED:
         return None
-    return numba.njit(cache=True, nogil=True)(function)
+    if name not in _CACHE:
+        try:
+            import numba
+        except ImportError:  # pragma: no cover - depends on the installation
+            log.debug('numba is not installed; the lean step runs its numpy twins')
+            _CACHE[name] = None
+        else:
+            _CACHE[name] = numba.njit(cache=True, nogil=True)(_KERNELS[name])
+    return _CACHE[name]
 
 
 def _moving_load(positions: np.ndarray, forces: np.ndarray, h: float, n_el: int,
@@ -74,10 +86,6 @@ def _moving_load(positions: np.ndarray, forces: np.ndarray, h: float, n_el: int,
         out[dofs[element, 3]] += r3
 
 
-moving_load = _jit(_moving_load)
-"""Compiled :func:`_moving_load`, or None without numba."""
-
-
 def _history(u: np.ndarray, v: np.ndarray, a: np.ndarray, a0: float, a1: float,
              h_v: np.ndarray, h_a: np.ndarray) -> None:
     """Newmark history terms into h_v, h_a: the arithmetic of the lean numpy path."""
@@ -99,7 +107,5 @@ def _finish(u: np.ndarray, a0: float, a1: float, h_v: np.ndarray,
     return v, a
 
 
-history = _jit(_history)
-"""Compiled :func:`_history`, or None without numba."""
-finish = _jit(_finish)
-"""Compiled :func:`_finish`, or None without numba."""
+_KERNELS: dict[str, Callable[..., Any]] = {
+    'moving_load': _moving_load, 'history': _history, 'finish': _finish}

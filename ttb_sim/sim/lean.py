@@ -109,7 +109,7 @@ class MovingLoad:
         self._forces = np.asarray(forces, dtype=float)
         self._n_free = n_free
         self._n_full = n_full
-        self._kernel = kernels.moving_load
+        self._kernel = kernels.compiled('moving_load')
         self._out = np.zeros(n_free + 1)
 
     def __call__(self, positions: np.ndarray) -> np.ndarray:

@@ -69,7 +69,8 @@ class Newmark:
             self._history = np.zeros(2 * n)
             self._h_a, self._h_v = self._history[:n], self._history[n:]
             self._work = np.zeros(n)
-        self._compiled = lean and kernels.history is not None
+        self._history_kernel = kernels.compiled('history') if lean else None
+        self._finish_kernel = kernels.compiled('finish') if lean else None
 
     def history(self, u: np.ndarray, v: np.ndarray,
                 a: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -80,8 +81,8 @@ class Newmark:
         unknown end-of-step displacement. With ``lean`` the two are views of one
         work vector, overwritten by the next call.
         """
-        if self._compiled:
-            kernels.history(u, v, a, self.a0, self.a1, self._h_v, self._h_a)
+        if self._history_kernel is not None:
+            self._history_kernel(u, v, a, self.a0, self.a1, self._h_v, self._h_a)
             return self._h_v, self._h_a
         if self.lean:
             h_a, h_v, work = self._h_a, self._h_v, self._work
@@ -109,8 +110,8 @@ class Newmark:
     def finish(self, u_new: np.ndarray, h_v: np.ndarray,
                h_a: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Return the end-of-step velocity and acceleration."""
-        if self._compiled:
-            v, a = kernels.finish(u_new, self.a0, self.a1, h_v, h_a)
+        if self._finish_kernel is not None:
+            v, a = self._finish_kernel(u_new, self.a0, self.a1, h_v, h_a)
             return v, a
         return self.a1 * u_new + h_v, self.a0 * u_new + h_a
 
