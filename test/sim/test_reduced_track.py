@@ -110,12 +110,12 @@ def test_reduced_run_with_moving_window_follows_the_full_model(monkeypatch):
     """
     A run whose window moves every metre agrees with the full model.
 
-    Small margins make the window move about every 1.2 m (six times in 5 m of
-    travel), so the state hand-over is exercised far more than in a real run.
-    Measured: wheel-rail Fz within 0.01 % RMS, girder mid-span within 0.1 %.
+    ADVANCE = 1 m makes the window move five times in 5 m of travel, so the
+    state hand-over is exercised far more than in a real run (every 40 m).
+    Measured (RMS of the difference over the reference's RMS): wheel-rail Fz
+    1.6e-5, Fy 8.3e-3 (1.2 kN RMS here; 8.1e-3 without moves), girder mid-span
+    3.1e-5. With 15 m margins instead of 30: Fz 6e-4, Fy 1.2e-2, mid-span 6e-4.
     """
-    monkeypatch.setattr(reduced_track, 'BACK_MARGIN', 15.0)
-    monkeypatch.setattr(reduced_track, 'FRONT_MARGIN', 15.0)
     monkeypatch.setattr(reduced_track, 'ADVANCE', 1.0)
 
     def run(variant):
@@ -137,5 +137,5 @@ def test_reduced_run_with_moving_window_follows_the_full_model(monkeypatch):
     def rms(x):
         return float(np.sqrt(np.mean(x**2)))
 
-    for name, a, b, tol in zip(('Fz', 'Fy', 'mid'), reduced, full, (1e-3, 1e-2, 1e-2)):
+    for name, a, b, tol in zip(('Fz', 'Fy', 'mid'), reduced, full, (2e-4, 1.5e-2, 3e-4)):
         assert rms(a - b) <= tol * rms(b), name
