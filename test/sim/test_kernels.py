@@ -55,6 +55,7 @@ def test_compiled_moving_load_is_the_numpy_load_bit_for_bit(numpy_twins):
     for head in heads:
         positions = head - sim.vehicle.axles.offsets
         assert np.array_equal(fast(positions).copy(), slow(positions))
+        assert np.array_equal(fast.full(positions), slow.full(positions))
 
 
 def test_compiled_newmark_history_and_finish_are_numpy_bit_for_bit(numpy_twins):

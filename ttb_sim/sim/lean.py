@@ -130,6 +130,11 @@ class MovingLoad:
 
     def full(self, positions: np.ndarray) -> np.ndarray:
         """Return the (n_full,) load on all DOFs, for the support reactions of a frame."""
+        if self._kernel is not None:
+            out = np.empty(self._n_full)
+            self._kernel(np.asarray(positions, dtype=float), self._forces, float(self._h),
+                         self._n_el, float(self._length), self._dofs_full, out)
+            return out
         element, rows = self._rows(positions)
         return np.bincount(self._dofs_full[element].ravel(), weights=rows.ravel(),
                            minlength=self._n_full)
