@@ -110,17 +110,18 @@ def test_reduced_run_with_moving_window_follows_the_full_model(monkeypatch):
     """
     A run whose window moves every metre agrees with the full model.
 
-    ADVANCE = 1 m makes the window move five times in 5 m of travel, so the
+    ADVANCE = 1 m makes the window move three times in 3.3 m of travel, so the
     state hand-over is exercised far more than in a real run (every 40 m).
-    Measured (RMS of the difference over the reference's RMS): wheel-rail Fz
-    1.6e-5, Fy 8.3e-3 (1.2 kN RMS here; 8.1e-3 without moves), girder mid-span
-    3.1e-5. With 15 m margins instead of 30: Fz 6e-4, Fy 1.2e-2, mid-span 6e-4.
+    Measured over 0.06 s (5 m, five moves; RMS of the difference over the
+    reference's RMS): wheel-rail Fz 1.6e-5, Fy 8.3e-3 (1.2 kN RMS here; 8.1e-3
+    without moves), girder mid-span 3.1e-5. With 15 m margins instead of 30:
+    Fz 6e-4, Fy 1.2e-2, mid-span 6e-4. The test runs 0.04 s.
     """
     monkeypatch.setattr(reduced_track, 'ADVANCE', 1.0)
 
     def run(variant):
         scenario = load_scenario('moving_force_beam', values=SMALL + [
-            ('solver.variant', variant), ('solver.duration', 0.06),
+            ('solver.variant', variant), ('solver.duration', 0.04),
             ('irregularity.spectrum', 'paper'), ('irregularity.seed', 2)])
         sim = Simulation(scenario)
         frames = list(sim.frames())
@@ -130,7 +131,7 @@ def test_reduced_run_with_moving_window_follows_the_full_model(monkeypatch):
         return sim, fz, fy, mid
 
     sim, *reduced = run('reduced')
-    assert sim.coupling.window_moves >= 4
+    assert sim.coupling.window_moves >= 3
     assert sim.coupling.n_free < sim.structure.n_free
     _, *full = run('qdldl')
 
