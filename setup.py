@@ -36,7 +36,10 @@ setup(
                       # solver.variant (README, Benchmark); each is optional at run time:
                       # without it the variants fall back to scipy / leave BLAS threads as
                       # they are.
-                      'cholespy>=2.0', 'qdldl>=0.1.7', 'threadpoolctl>=3'],
+                      'cholespy>=2.0', 'qdldl>=0.1.7', 'threadpoolctl>=3',
+                      # compiled kernels of the lean step (ttb_sim/sim/kernels.py); without
+                      # it the numpy twins run.
+                      'numba>=0.59'],
     extras_require={
         'test': ['pytest>=7', 'mcap>=1.1', 'mcap-ros2-support>=0.5', 'flake8>=6',
                  'flake8-quotes', 'flake8-import-order', 'flake8-builtins',

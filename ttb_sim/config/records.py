@@ -135,8 +135,10 @@ class SolverConfig:
                          'symmetric effective matrices with a fill-reducing order and take the '
                          "lean step: 'qdldl' (LDL^T, the fastest measured), 'cholmod' "
                          "(CHOLMOD Cholesky via cholespy), 'superlu_sym' (pure scipy). They "
-                         "agree with 'reference' to round-off (README, Benchmark).",
-                         choices=('qdldl', 'cholmod', 'superlu_sym', 'reference'))
+                         "agree with 'reference' to round-off (README, Benchmark). 'reduced' "
+                         '(opt-in) is qdldl with the slab track detailed only in a window '
+                         'around the train, the far track condensed onto the bridge.',
+                         choices=('qdldl', 'cholmod', 'superlu_sym', 'reference', 'reduced'))
 
 
 @dataclass(frozen=True)

@@ -134,7 +134,8 @@ class Simulation:
                                       method=self.variant.factorization,
                                       lean=self.variant.lean)
             self.coupling = build_coupling(scenario, st, self.vehicle, self.integrator,
-                                           self.irregularity, lean=self.variant.lean)
+                                           self.irregularity, lean=self.variant.lean,
+                                           reduced=self.variant.reduced)
         self.layout = Layout(n_spans=scenario.bridge.n_spans, n_supports=st.n_supports,
                              n_bodies=self.coupling.n_bodies, n_axles=self.coupling.n_axles,
                              observers=names)
