@@ -26,7 +26,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Sequence
+from typing import Any, Sequence
 
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
@@ -34,7 +34,7 @@ import numpy as np
 
 from ttb_sim.analysis.excitation import Excitation
 
-__all__ = ['Panel', 'bar_levels_figure', 'contour_figure', 'indices_figure', 'panels_figure']
+__all__ = ['Panel', 'contour_figure', 'indices_figure', 'panels_figure']
 
 Trace = tuple[str, np.ndarray, np.ndarray]
 """(label, x, y) of one line."""
@@ -55,7 +55,8 @@ class Panel:
     logy: bool = False
     xlim: tuple[float, float] | None = None
     marks: Sequence[Excitation] = field(default_factory=list)
-    style: str = 'line'   # 'line' or 'step'
+    style: str = 'line'   # 'line', 'step', or 'sweep' (markers and a mean line)
+    legend: bool = False  # a legend even for one trace
 
 
 def _save(fig: Figure, path: Path) -> None:
@@ -63,46 +64,58 @@ def _save(fig: Figure, path: Path) -> None:
     fig.savefig(str(path), dpi=110)
 
 
-def _mark(ax: object, marks: Sequence[Excitation], xlim: tuple[float, float] | None) -> None:
-    """Draw excitation frequencies and bands on a frequency axis, labelled at the top."""
+def _mark(ax: Any, marks: Sequence[Excitation], xlim: tuple[float, float] | None) -> list[Any]:
+    """Draw excitation frequencies (dashed) and bands (shaded); return their legend handles."""
     lo, hi = xlim if xlim else (-np.inf, np.inf)
+    handles = []
     for i, m in enumerate(marks):
         if m.high < lo or m.low > hi:
             continue
         colour = _MARK_COLOURS[i % len(_MARK_COLOURS)]
+        label = f'{m.label}: {m.low:.3g}' + (f'-{m.high:.3g}' if m.is_band else '') + ' Hz'
         if m.is_band:
-            ax.axvspan(m.low, m.high, color=colour, alpha=0.15, lw=0)  # type: ignore
+            handles.append(ax.axvspan(m.low, m.high, color=colour, alpha=0.18, lw=0,
+                                      label=label))
         else:
-            ax.axvline(m.low, color=colour, ls='--', lw=0.9)  # type: ignore
-        label = f'{m.label} {m.low:.3g}' + (f'-{m.high:.3g}' if m.is_band else '') + ' Hz'
-        ax.text(m.low, 0.98 - 0.07 * (i % 6), label, color=colour,  # type: ignore
-                transform=ax.get_xaxis_transform(), fontsize=7,  # type: ignore
-                ha='left', va='top', rotation=0,
-                bbox={'facecolor': 'white', 'alpha': 0.6, 'lw': 0, 'pad': 0.5})
+            handles.append(ax.axvline(m.low, color=colour, ls='--', lw=0.9, label=label))
+    return handles
 
 
-def _draw(ax: object, panel: Panel) -> None:
+def _draw(ax: Any, panel: Panel) -> None:
+    lines = []
+    top = -np.inf
     for label, x, y in panel.traces:
         xs, ys = np.asarray(x, dtype=float), np.asarray(y, dtype=float)
         if panel.logy:
             ys = np.where(ys > 0, ys, np.nan)
+        if np.any(np.isfinite(ys)):
+            top = max(top, float(np.nanmax(ys)))
         if panel.style == 'step':
-            ax.step(xs, ys, where='mid', label=label, lw=1.0)  # type: ignore
+            lines.extend(ax.step(xs, ys, where='mid', label=label, lw=1.0))
+        elif panel.style == 'sweep' and label.startswith('cases'):
+            lines.extend(ax.plot(xs, ys, 'o', label=label, ms=4, alpha=0.6))
+        elif panel.style == 'sweep':
+            lines.extend(ax.plot(xs, ys, '-s', label=label, lw=1.2, ms=4))
         else:
-            ax.plot(xs, ys, label=label, lw=0.8)  # type: ignore
+            lines.extend(ax.plot(xs, ys, label=label, lw=0.8))
     if panel.logx:
-        ax.set_xscale('log')  # type: ignore
+        ax.set_xscale('log')
     if panel.logy:
-        ax.set_yscale('log')  # type: ignore
+        ax.set_yscale('log')
+        if np.isfinite(top) and top > 0:   # eight decades below the top: filters' floors hidden
+            ax.set_ylim(bottom=max(ax.get_ylim()[0], top * 1e-8), top=top * 5.0)
     if panel.xlim:
-        ax.set_xlim(*panel.xlim)  # type: ignore
-    ax.set_xlabel(panel.xlabel)  # type: ignore
-    ax.set_ylabel(panel.ylabel)  # type: ignore
-    ax.set_title(panel.title, fontsize=9)  # type: ignore
-    ax.grid(True, which='major', alpha=0.3)  # type: ignore
-    _mark(ax, panel.marks, panel.xlim)
-    if len(panel.traces) > 1:
-        ax.legend(fontsize=7, loc='lower left' if panel.logy else 'best')  # type: ignore
+        ax.set_xlim(*panel.xlim)
+    ax.set_xlabel(panel.xlabel)
+    ax.set_ylabel(panel.ylabel)
+    ax.set_title(panel.title, fontsize=9)
+    ax.grid(True, which='major', alpha=0.3)
+    handles = _mark(ax, panel.marks, panel.xlim)
+    if len(panel.traces) > 1 or panel.legend:
+        handles = lines + handles
+    if handles:
+        ax.legend(handles=handles, fontsize=6.5, framealpha=0.75,
+                  loc='best')
 
 
 def panels_figure(path: Path, title: str, rows: Sequence[Sequence[Panel]]) -> Path:
@@ -121,48 +134,6 @@ def panels_figure(path: Path, title: str, rows: Sequence[Sequence[Panel]]) -> Pa
                 _draw(axes[i][j], row[j])
             else:
                 axes[i][j].set_visible(False)
-    _save(fig, path)
-    return path
-
-
-def bar_levels_figure(path: Path, title: str, centres: np.ndarray,
-                      levels: Sequence[tuple[str, np.ndarray]], ylabel: str,
-                      marks: Sequence[Excitation] = ()) -> Path:
-    """Write levels per 1/3-octave band (grouped bars, one group per band centre) to a PNG."""
-    fig = Figure(figsize=(10.0, 4.2), layout='constrained')
-    fig.suptitle(title, fontsize=11)
-    ax = fig.subplots()
-    k = max(len(levels), 1)
-    x = np.log10(centres)
-    width = 0.1 / k * 0.9
-    floor = min((np.nanmin(np.where(np.isfinite(v), v, np.nan)) for _, v in levels
-                 if np.any(np.isfinite(v))), default=0.0) - 10.0
-    for i, (label, values) in enumerate(levels):
-        v = np.where(np.isfinite(values), values, floor)
-        ax.bar(x + (i - (k - 1) / 2) * width, v - floor, width, bottom=floor, label=label)
-    ax.set_xticks(x)
-    ax.set_xticklabels([f'{c:.3g}' for c in centres], rotation=90, fontsize=7)
-    ax.set_xlabel('1/3-octave band centre frequency (Hz)')
-    ax.set_ylabel(ylabel)
-    ax.grid(True, axis='y', alpha=0.3)
-    log_marks = [Excitation(m.label, float(np.log10(m.low)), float(np.log10(m.high)))
-                 for m in marks if m.low > 0]
-    lo, hi = x[0] - 0.05, x[-1] + 0.05
-    ax.set_xlim(lo, hi)
-    for i, (m, orig) in enumerate(zip(log_marks, [m for m in marks if m.low > 0])):
-        if m.high < lo or m.low > hi:
-            continue
-        colour = _MARK_COLOURS[i % len(_MARK_COLOURS)]
-        if m.is_band:
-            ax.axvspan(m.low, m.high, color=colour, alpha=0.15, lw=0)
-        else:
-            ax.axvline(m.low, color=colour, ls='--', lw=0.9)
-        text = f'{orig.label} {orig.low:.3g}' + (f'-{orig.high:.3g}' if orig.is_band else '')
-        ax.text(m.low, 0.98 - 0.07 * (i % 6), text + ' Hz', color=colour, fontsize=7,
-                transform=ax.get_xaxis_transform(), va='top',
-                bbox={'facecolor': 'white', 'alpha': 0.6, 'lw': 0, 'pad': 0.5})
-    if len(levels) > 1:
-        ax.legend(fontsize=7, loc='lower right')
     _save(fig, path)
     return path
 
