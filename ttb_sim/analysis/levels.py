@@ -16,7 +16,8 @@
 Vibration acceleration levels in 1/3-octave bands (PHYSICS.md section 8, [P] Fig. 26).
 
 ``VAL = 20 log10(a_rms / a0)`` dB with a0 = 1e-6 m/s^2, per 1/3-octave band:
-centres ``10^(n/10)`` Hz (nominal 1, 1.25, 1.6, ... 80 Hz), edges ``f_c 2^(+-1/6)``.
+centres ``10^(n/10)`` Hz (nominal 1, 1.25, 1.6, ... 80 Hz), edges ``f_c 10^(+-1/20)``
+(the base-10 form of ``f_c 2^(+-1/6)``, 0.08 % apart, so that the bands tile the axis).
 Band r.m.s. values are summed from the record's FFT lines (Parseval, mean
 removed), so the band powers add up to the record's variance and a sine lying
 inside one band gives ``20 log10(A / sqrt(2) / a0)`` there.
@@ -52,7 +53,7 @@ def third_octave_bands(lowest: float = 1.0, highest: float = 80.0
                   math.ceil(10 * math.log10(highest * 1.02)) + 1)
     centres = 10.0 ** (n / 10.0)
     centres = centres[(centres >= lowest * 0.98) & (centres <= highest * 1.02)]
-    return centres, centres * 2.0 ** (-1 / 6), centres * 2.0 ** (1 / 6)
+    return centres, centres * 10.0 ** -0.05, centres * 10.0 ** 0.05
 
 
 def line_power(signal: ArrayLike, sample_rate: float
@@ -97,7 +98,7 @@ def vibration_levels(signal: ArrayLike, sample_rate: float, lowest: float = 1.0,
 
     Bands above the Nyquist frequency are left out. A band without power is -inf dB.
     """
-    centres, lo, hi = third_octave_bands(lowest, min(highest, 0.5 * sample_rate / 2 ** (1 / 6)))
+    centres, lo, hi = third_octave_bands(lowest, min(highest, 0.5 * sample_rate / 10 ** 0.05))
     rms = band_rms(signal, sample_rate, lo, hi)
     with np.errstate(divide='ignore'):
         return centres, np.asarray(20.0 * np.log10(rms / A0), dtype=float)

@@ -78,7 +78,7 @@ def sperling_index(acceleration: ArrayLike, sample_rate: float,
         Which correction F(f) applies.
 
     """
-    _, lo, hi = third_octave_bands(0.5, min(40.0, 0.5 * sample_rate / 2 ** (1 / 6)))
+    _, lo, hi = third_octave_bands(0.5, min(40.0, 0.5 * sample_rate / 10 ** 0.05))
     power, centroid = band_sums(*line_power(acceleration, sample_rate), lo, hi)
     amplitude = np.sqrt(2.0 * power) / GRAVITY
     terms = 7.08**10 * amplitude**3 * sperling_correction(centroid, direction) / centroid
