@@ -256,9 +256,8 @@ def power_flow(bags: Sequence[Streams], out: Path) -> FigureNote:
                    'on a slab track, and summary.json for the layer properties')
     marks = _marks(bags)
     stations = sorted(set().union(*(f for _, f in flows)))
-    rows = []
+    panels = []
     for station in stations:
-        row = []
         for layer in _LAYERS:
             traces = []
             total = []
@@ -267,10 +266,10 @@ def power_flow(bags: Sequence[Streams], out: Path) -> FigureNote:
                     freq, p = f[station][layer]
                     traces.append((s.label, freq[1:], np.abs(p[1:])))
                     total.append(f'{p.sum():.3g}')
-            row.append(Panel(f'{layer} at {station}: mean {" / ".join(total)} W/m',
-                             'frequency f (Hz)', '|P(f)| per line (W/m)', traces, logy=True,
-                             xlim=(0.0, 50.0), marks=marks))
-        rows.append(row)
+            panels.append(Panel(f'{layer} at {station}: mean {" / ".join(total)} W/m',
+                                'frequency f (Hz)', '|P(f)| per line (W/m)', traces,
+                                logy=True, xlim=(0.0, 50.0), marks=marks))
+    rows = [panels[i:i + 2] for i in range(0, len(panels), 2)]
     path = panels_figure(out / 'power_flow.png', 'Vibration power flow per layer ([P] Eqs. '
                          '17-18, Figs. 18-19)', rows)
     return FigureNote(path.name, 'Power flow P(f) = 1/2 Re[F V*] per FFT line, W per metre of '
