@@ -81,7 +81,7 @@ def _mark(ax: Any, marks: Sequence[Excitation], xlim: tuple[float, float] | None
     return handles
 
 
-def _draw(ax: Any, panel: Panel) -> None:
+def _draw(ax: Any, panel: Panel, mark_legend: bool = True) -> None:
     lines = []
     top = -np.inf
     for label, x, y in panel.traces:
@@ -111,6 +111,8 @@ def _draw(ax: Any, panel: Panel) -> None:
     ax.set_title(panel.title, fontsize=9)
     ax.grid(True, which='major', alpha=0.3)
     handles = _mark(ax, panel.marks, panel.xlim)
+    if not mark_legend:
+        handles = []
     if len(panel.traces) > 1 or panel.legend:
         handles = lines + handles
     if handles:
@@ -131,12 +133,14 @@ def panels_figure(path: Path, title: str, rows: Sequence[Sequence[Panel]]) -> Pa
     axes = fig.subplots(n_rows, n_cols, squeeze=False)
     # a fixed layout in inches (constrained layout costs seconds per figure)
     fig.subplots_adjust(left=0.85 / width, right=1 - 0.25 / width, bottom=0.55 / height,
-                        top=1 - 0.6 / height, wspace=1.0 / (6.0 - 1.0),
+                        top=1 - 0.85 / height, wspace=1.0 / (6.0 - 1.0),
                         hspace=0.9 / (3.4 - 0.9))
+    legend_done = False   # the excitation marks are explained once, in the first panel
     for i, row in enumerate(rows):
         for j in range(n_cols):
             if j < len(row):
-                _draw(axes[i][j], row[j])
+                _draw(axes[i][j], row[j], not legend_done)
+                legend_done = legend_done or bool(row[j].marks)
             else:
                 axes[i][j].set_visible(False)
     _save(fig, path)
