@@ -162,7 +162,7 @@ class _Dask:
                                   key=[f'ttb-sim-{c.name}-{os.getpid()}-{time.time_ns()}'
                                        for c in cases])
         by_key = {f.key: c for f, c in zip(futures, cases)}
-        for fut in dask_completed(futures):
+        for fut in dask_completed(futures, loop=self.client.loop):
             yield by_key[fut.key], _result(by_key[fut.key], fut.result, fut.exception)
 
     def close(self) -> None:
