@@ -68,7 +68,7 @@ def line_power(signal: ArrayLike, sample_rate: float
         raise ValueError(f'sample_rate must be > 0, got {sample_rate!r}')
     power = np.abs(np.fft.rfft(x - x.mean()))**2 / x.size**2
     power[1:(x.size + 1) // 2] *= 2.0
-    return np.fft.rfftfreq(x.size, 1.0 / sample_rate), power
+    return np.asarray(np.fft.rfftfreq(x.size, 1.0 / sample_rate), dtype=float), power
 
 
 def band_sums(f: ArrayLike, power: ArrayLike, lower: ArrayLike, upper: ArrayLike

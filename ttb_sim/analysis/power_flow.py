@@ -76,7 +76,7 @@ def power_flow_spectrum(force: ArrayLike, velocity: ArrayLike, sample_rate: floa
     p[0] *= 0.5
     if n % 2 == 0:
         p[-1] *= 0.5
-    return np.fft.rfftfreq(n, 1.0 / sample_rate), p
+    return np.asarray(np.fft.rfftfreq(n, 1.0 / sample_rate), dtype=float), p
 
 
 def band_power(f: ArrayLike, p: ArrayLike, edges: ArrayLike) -> NDArray[np.float64]:
@@ -86,7 +86,8 @@ def band_power(f: ArrayLike, p: ArrayLike, edges: ArrayLike) -> NDArray[np.float
     e = np.asarray(edges, dtype=float)
     which = np.digitize(freq, e) - 1
     inside = (which >= 0) & (which < e.size - 1)
-    return np.bincount(which[inside], weights=power[inside], minlength=e.size - 1)
+    return np.asarray(np.bincount(which[inside], weights=power[inside], minlength=e.size - 1),
+                      dtype=float)
 
 
 def velocity_from_displacement(displacement: ArrayLike, sample_rate: float

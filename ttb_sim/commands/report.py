@@ -125,12 +125,12 @@ def bag_metrics(s: Streams) -> dict[str, Any]:
         cars: dict[str, Any] = {}
         for car, series in s.car_body.items():
             a, fs = series.values, series.rate
-            entry = {'vertical_peak_m_s2': float(np.max(np.abs(a[:, 2]))),
-                     'lateral_peak_m_s2': float(np.max(np.abs(a[:, 1]))),
-                     'sperling_vertical': sperling_index(a[:, 2], fs, 'vertical'),
-                     'sperling_lateral': sperling_index(a[:, 1], fs, 'lateral'),
-                     'wk_weighted_rms_m_s2': weighted_rms(a[:, 2], fs, 'Wk'),
-                     'wd_weighted_rms_m_s2': weighted_rms(a[:, 1], fs, 'Wd')}
+            entry: dict[str, Any] = {'vertical_peak_m_s2': float(np.max(np.abs(a[:, 2]))),
+                                     'lateral_peak_m_s2': float(np.max(np.abs(a[:, 1]))),
+                                     'sperling_vertical': sperling_index(a[:, 2], fs),
+                                     'sperling_lateral': sperling_index(a[:, 1], fs, 'lateral'),
+                                     'wk_weighted_rms_m_s2': weighted_rms(a[:, 2], fs, 'Wk'),
+                                     'wd_weighted_rms_m_s2': weighted_rms(a[:, 1], fs, 'Wd')}
             entry['vertical_psd_peak_hz'] = _body_peak(series)
             entry['sperling_vertical_grade'] = sperling_grade(entry['sperling_vertical'])
             cars[f'car{car:02d}'] = entry

@@ -123,8 +123,8 @@ def wheel_rail(bags: Sequence[Streams], out: Path) -> FigureNote:
 
 
 def _girder_spans(bags: Sequence[Streams]) -> list[int]:
-    spans = sorted(set().union(*(s.midspan for s in bags)))
-    picked = [k for k in (5, 7) if k in spans]   # [P]'s observation points ##2 and ##1
+    spans: list[int] = sorted(set().union(*(s.midspan for s in bags)))
+    picked: list[int] = [k for k in (5, 7) if k in spans]   # [P]'s observation points ##2 and ##1
     return picked or [spans[len(spans) // 2]]
 
 
@@ -180,8 +180,7 @@ def piles(bags: Sequence[Streams], out: Path) -> FigureNote:
 
 def ground(bags: Sequence[Streams], out: Path) -> FigureNote:
     """Ground acceleration at up to three points of the observation line: time beside PSD."""
-    lines = [(s, soil_line(s)) for s in bags]
-    lines = [(s, ln) for s, ln in lines if ln is not None]
+    lines = [(s, ln) for s in bags for ln in [soil_line(s)] if ln is not None]
     if not lines:
         raise Skip('no soil point cloud with az (soil/points)')
     marks = _marks(bags)
@@ -202,8 +201,7 @@ def ground(bags: Sequence[Streams], out: Path) -> FigureNote:
 
 def soil_val(bags: Sequence[Streams], out: Path) -> FigureNote:
     """VAL per 1/3 octave at up to three soil points (a0 = 1e-6 m/s^2)."""
-    lines = [(s, soil_line(s)) for s in bags]
-    lines = [(s, ln) for s, ln in lines if ln is not None and s.soil is not None]
+    lines = [(s, ln) for s in bags for ln in [soil_line(s)] if ln is not None]
     if not lines:
         raise Skip('no soil point cloud with az (soil/points)')
     marks = _marks(bags)

@@ -105,7 +105,7 @@ class Streams:
         out: list[Series] = []
         for d in (self.car_body, self.wheel_rail, self.midspan, self.bearing,
                   self.pile_displacement, self.pile_acceleration, self.observers):
-            out.extend(d.values())  # type: ignore[attr-defined]
+            out.extend(d.values())
         if self.soil is not None:
             out.append(self.soil)
         return out
