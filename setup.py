@@ -42,7 +42,8 @@ setup(
     extras_require={
         # ttb-sim sweep --scheduler ADDRESS (a Dask distributed cluster)
         'dask': ['dask[distributed]>=2023.1'],
-        'test': ['dask[distributed]>=2023.1', 'pytest>=7', 'mcap>=1.1', 'mcap-ros2-support>=0.5', 'flake8>=6',
+        'test': ['dask[distributed]>=2023.1',
+                 'pytest>=7', 'mcap>=1.1', 'mcap-ros2-support>=0.5', 'flake8>=6',
                  'flake8-quotes', 'flake8-import-order', 'flake8-builtins',
                  'flake8-comprehensions', 'flake8-class-newline', 'flake8-blind-except',
                  'flake8-deprecated', 'flake8-docstrings', 'pydocstyle>=6',
