@@ -217,12 +217,13 @@ def _wheel_rail_metrics(s: Streams) -> tuple[dict[str, Any], dict[str, Any]]:
         metrics['lateral_wheelset_force_limit_N'] = limit
         indices['lateral_wheelset_force'] = _index(h_max / 1e3, limit / 1e3, 'kN', h_where)
     first = s.wheel_rail[min(s.wheel_rail)]
-    if first.rate > 250.0 and first.t.size > 64:
-        f, p = welch_psd(first.values[:, 2], first.rate,
-                         segment_seconds=min(1.0, first.t.size / first.rate / 4))
+    junction = next((m.low for m in marks_of(s) if m.label.startswith('V/')), None)
+    if junction and first.rate > 4.0 * junction and first.t.size / first.rate >= 2.0:
+        # as V19: 0.5 s Welch segments, the step searched within an octave of V / lambda
+        f, p = welch_psd(first.values[:, 2], first.rate, segment_seconds=0.5)
         try:
             metrics['vertical_psd_level_change_hz'] = level_change_frequency(
-                f, p, (20.0, min(0.45 * first.rate, 250.0)), direction='down')
+                f, p, (0.5 * junction, 2.0 * junction))
         except ValueError as exc:
             log.info('no level change frequency of the wheel-rail PSD: %s', exc)
     return metrics, indices

@@ -74,10 +74,11 @@ def _time_psd_row(name: str, what: str, unit: str, scale: float,
     spectra = []
     for lbl, s, x in traces:
         f, p = _psd(s, x * scale, lowest_hz)
-        spectra.append((f'{lbl} (bins {f[1]:.3g} Hz)', f[1:], p[1:]))
+        spectra.append((lbl, f[1:], p[1:]))
+    bins = ' / '.join(sorted({f'{t[1][1] - t[1][0]:.3g}' for t in spectra}))
     top = min(fmax, min(s.rate for _, s, _ in traces) / 2)
     lo = spectra[0][1][0] if logf else 0.0
-    psd = Panel(f'{name}: PSD (Welch, Hann)', 'frequency f (Hz)',
+    psd = Panel(f'{name}: PSD (Welch, Hann, bins {bins} Hz)', 'frequency f (Hz)',
                 f'PSD of {what} ({unit})$^2$/Hz', spectra, logx=logf, logy=True,
                 xlim=(lo, top), marks=marks)
     return [time, psd]
@@ -102,7 +103,7 @@ def car_body(bags: Sequence[Streams], out: Path) -> FigureNote:
                          '([P] Fig. 12)', rows)
     return FigureNote(path.name, f'Car-body acceleration of car{car:02d} (gravity excluded): '
                       'time history and Welch PSD; the window resolves 0.84 Hz where the '
-                      'record allows (else the whole record, bin size in the legend).')
+                      'record allows (else the whole record; bin size in the title).')
 
 
 def wheel_rail(bags: Sequence[Streams], out: Path) -> FigureNote:
