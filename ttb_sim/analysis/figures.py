@@ -57,6 +57,7 @@ class Panel:
     marks: Sequence[Excitation] = field(default_factory=list)
     style: str = 'line'   # 'line', 'step', or 'sweep' (markers and a mean line)
     legend: bool = False  # a legend even for one trace
+    floor_below_top: float | None = None   # linear y axis: show only this far below the top
 
 
 def _save(fig: Figure, path: Path) -> None:
@@ -104,6 +105,8 @@ def _draw(ax: Any, panel: Panel, mark_legend: bool = True) -> None:
         ax.set_yscale('log')
         if np.isfinite(top) and top > 0:   # eight decades below the top: filters' floors hidden
             ax.set_ylim(bottom=max(ax.get_ylim()[0], top * 1e-8), top=top * 5.0)
+    if panel.floor_below_top is not None and np.isfinite(top):
+        ax.set_ylim(bottom=top - panel.floor_below_top, top=top + 0.08 * panel.floor_below_top)
     if panel.xlim:
         ax.set_xlim(*panel.xlim)
     ax.set_xlabel(panel.xlabel)
@@ -174,9 +177,10 @@ def indices_figure(path: Path, title: str,
     value over its limit (1 = at the limit), annotated with the value and unit.
     """
     fig = Figure(figsize=(9.0, 0.55 * max(len(rows), 1) * max(len(rows[0][1]), 1) + 1.6
-                          if rows else 2.0), layout='constrained')
+                          if rows else 2.0))
     fig.suptitle(title, fontsize=11)
     ax = fig.subplots()
+    fig.subplots_adjust(left=0.32, right=0.97)
     y = 0.0
     ticks, names = [], []
     for name, values, limit, unit in rows:
@@ -184,7 +188,8 @@ def indices_figure(path: Path, title: str,
             ratio = value / limit if limit else np.nan
             colour = 'tab:green' if ratio <= 1.0 else 'tab:red'
             ax.barh(y, ratio, color=colour, height=0.8, alpha=0.8)
-            ax.text(max(ratio, 0) + 0.01, y, f'{value:.3g} {unit} (limit {limit:.3g})',
+            shown = '' if unit in ('', '-') else f' {unit}'
+            ax.text(max(ratio, 0) + 0.01, y, f'{value:.3g}{shown} (limit {limit:.3g}{shown})',
                     va='center', fontsize=7)
             ticks.append(y)
             names.append(f'{name} [{label}]' if len(values) > 1 else name)

@@ -214,9 +214,11 @@ def soil_val(bags: Sequence[Streams], out: Path) -> FigureNote:
             if s.soil is not None and i < az.shape[1]:
                 c, v = vibration_levels(az[:, i], s.soil.rate)
                 traces.append((s.label, c, v))
-        panels.append(Panel(f'point at {d0[i]:.1f} m', '1/3-octave band centre frequency '
+        panels.append(Panel(f'point at {d0[i]:.1f} m along the line', '1/3-octave band centre '
+                            'frequency '
                             '(Hz)', 'VAL (dB re 1e-6 m/s$^2$)', traces, logx=True,
-                            style='step', xlim=(0.9, 90.0), marks=marks))
+                            style='step', xlim=(0.9, 90.0), marks=marks,
+                            floor_below_top=80.0))
     path = panels_figure(out / 'soil_val.png', 'Vibration acceleration level per 1/3 octave '
                          '([P] Fig. 26)', [[p] for p in panels])
     return FigureNote(path.name, 'Vertical vibration acceleration level VAL = 20 log10(a_rms '
@@ -230,15 +232,19 @@ def soil_contour(bags: Sequence[Streams], out: Path) -> list[FigureNote]:
         line = soil_line(s)
         if line is None or s.soil is None:
             continue
-        _, distance, az = line
+        order, distance, az = line
         if az.shape[1] < 2:
             continue
+        ends = s.soil.values[0][order[[0, -1]]]
+        x, y = s.soil_fields.index('x'), s.soil_fields.index('y')
+        where = f'from ({ends[0, x]:.1f}, {ends[0, y]:.1f}) to ({ends[1, x]:.1f}, ' \
+            f'{ends[1, y]:.1f}) m'
         name = 'soil_contour.png' if len(bags) == 1 else \
             f'soil_contour_{re.sub(r"[^A-Za-z0-9_.-]", "_", s.label)}.png'
-        contour_figure(out / name, f'Ground vertical acceleration along the observation line, '
-                       f'{s.label} ([P] Fig. 25)', s.soil.t, distance, az, 'time t (s)',
-                       'distance along the observation line (m)', 'vertical acceleration '
-                       '(m/s$^2$)')
+        contour_figure(out / name, f'Ground vertical acceleration along the observation line '
+                       f'{where}, {s.label} ([P] Fig. 25)', s.soil.t, distance, az,
+                       'time t (s)', 'distance along the observation line (m)',
+                       'vertical acceleration (m/s$^2$)')
         notes.append(FigureNote(name, f'{s.label}: vertical ground acceleration along the soil '
                                 'observation line against time.'))
     if not notes:
