@@ -92,9 +92,10 @@ def frame(k: int, scale: float = 1.0) -> Frame:
 
 
 def write_bag(path: Path, storage: str = 'mcap', scale: float = 1.0,
-              summary: bool = True, layout: Layout = LAYOUT) -> Path:
+              summary: bool = True, layout: Layout = LAYOUT,
+              namespace: str = '/ttb_sim') -> Path:
     """Write the synthetic bag (and its summary.json) at ``path``; return it."""
-    with BagRecorder(path, topic_table(layout), storage) as bag:
+    with BagRecorder(path, topic_table(layout), storage, namespace=namespace) as bag:
         for k in range(SAMPLES):
             bag.write(frame(k, scale))
     if summary:

@@ -134,6 +134,16 @@ def test_sqlite3_bag_gives_the_same_metrics(analysed, tmp_path):
         flatten(m['power_flow_mean_W_per_m']), rel=1e-12)
 
 
+def test_a_renamed_node_without_summary_is_read_by_topic_endings(tmp_path):
+    """A bag recorded from a node run as ``__node:=twin`` (no summary.json) still analyses."""
+    bag = sb.write_bag(tmp_path / 'bag', summary=False, namespace='/twin')
+    m = bag_metrics(load_streams(bag))
+    assert m['speed_kmh'] == pytest.approx(300.0)
+    assert m['car_body']['car01']['vertical_peak_m_s2'] == pytest.approx(sb.CAR_Z[0], rel=1e-3)
+    assert 'power_flow_mean_W_per_m' not in m   # observer positions unknown without summary
+    assert m['excitation_hz'] == {'V/\u03bb (Eq. 15)': [pytest.approx(300 / 3.6)] * 2}
+
+
 def test_without_summary_figures_needing_it_are_skipped_and_rerun_replaces(tmp_path):
     bag = sb.write_bag(tmp_path / 'bag', summary=False)
     (bag / 'analysis').mkdir()
