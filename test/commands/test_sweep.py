@@ -128,3 +128,27 @@ def test_sweep_on_a_local_dask_cluster(tmp_path):
     assert len(rows) == 4 and all(r['status'] == 'ok' for r in rows.values())
     pids = {json.loads((out / n / 'case.json').read_text())['pid'] for n in rows}
     assert len(pids) >= 1
+
+
+def test_ctrl_c_stops_the_workers_in_one_line(tmp_path):
+    """SIGINT while cases run: one line, exit 130, no traceback from the workers."""
+    import os
+    import signal
+    import subprocess
+    import sys
+    import time
+    out = tmp_path / 'sw'
+    proc = subprocess.Popen([sys.executable, '-m', 'ttb_sim.cli', 'sweep', 'ten_span_train',
+                             '--speeds-kmh', '250,300,350,400', '--workers', '2', '--out',
+                             str(out)], stderr=subprocess.PIPE, text=True,
+                            start_new_session=True)
+    assert proc.stderr is not None
+    line = proc.stderr.readline()
+    assert 'running 4 cases' in line, line
+    time.sleep(1.0)
+    os.killpg(proc.pid, signal.SIGINT)   # as a terminal does: the whole process group
+    _, err = proc.communicate(timeout=120)
+    assert proc.returncode == 130, err
+    assert 'Traceback' not in err
+    assert 'stopped by SIGINT' in err and 'rerun the same command to resume' in err
+    assert not (out / 'sweep.csv').exists()

@@ -39,7 +39,9 @@ import logging
 import multiprocessing
 import os
 from pathlib import Path
+import signal
 import sys
+import threading
 import time
 from typing import Any, Callable, Iterator, Sequence
 
@@ -119,21 +121,49 @@ def _check_settings(out: Path, settings: dict[str, Any]) -> None:
                             '(no sweep.json); give a new or empty folder')
 
 
+def _ignore_interrupts() -> None:
+    """Worker initializer: Ctrl-C is the parent's to handle (it terminates the workers)."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+
+
+class _Stopped(Exception):
+    """SIGINT or SIGTERM arrived while cases ran."""
+
+    def __init__(self, signum: int) -> None:
+        super().__init__(signum)
+        self.signum = signum
+
+
+def _raise_stopped(signum: int, frame: object) -> None:
+    raise _Stopped(signum)
+
+
 class _Local:
     """Cases in local worker processes (spawned, so each starts clean)."""
 
     def __init__(self, workers: int) -> None:
         self.pool = ProcessPoolExecutor(max_workers=workers,
-                                        mp_context=multiprocessing.get_context('spawn'))
+                                        mp_context=multiprocessing.get_context('spawn'),
+                                        initializer=_ignore_interrupts)
 
-    def run(self, cases: Sequence[CaseSpec]) -> Iterator[tuple[CaseSpec, dict[str, Any]]]:
-        futures: dict[Future[dict[str, Any]], CaseSpec] = {
+    def submit(self, cases: Sequence[CaseSpec]) -> None:
+        """Queue the cases (this starts the worker processes)."""
+        self.futures: dict[Future[dict[str, Any]], CaseSpec] = {
             self.pool.submit(run_case, c): c for c in cases}
-        for fut in as_completed(futures):
-            yield futures[fut], _result(futures[fut], fut.result, fut.exception)
+
+    def results(self) -> Iterator[tuple[CaseSpec, dict[str, Any]]]:
+        """Yield (case, record) as cases finish."""
+        for fut in as_completed(self.futures):
+            yield self.futures[fut], _result(self.futures[fut], fut.result, fut.exception)
 
     def close(self) -> None:
         self.pool.shutdown(wait=True, cancel_futures=True)
+
+    def stop(self) -> None:
+        """Terminate the workers at once (their cases have no case.json: redone next time)."""
+        for process in list(getattr(self.pool, '_processes', {}).values()):
+            process.terminate()
+        self.pool.shutdown(wait=False, cancel_futures=True)
 
 
 class _Dask:
@@ -153,19 +183,31 @@ class _Dask:
                                 f'{SCHEDULER_TIMEOUT_S:g} s ({type(exc).__name__}: {exc}); '
                                 'give the address of a running dask scheduler, e.g. '
                                 'tcp://host:8786') from None
+        self.futures: list[Any] = []
+        self.by_key: dict[Any, CaseSpec] = {}
         workers = self.client.scheduler_info().get('workers', {})
         log.info('Dask scheduler %s with %d workers', address, len(workers))
 
-    def run(self, cases: Sequence[CaseSpec]) -> Iterator[tuple[CaseSpec, dict[str, Any]]]:
+    def submit(self, cases: Sequence[CaseSpec]) -> None:
+        """Send the cases to the scheduler."""
+        keys = [f'ttb-sim-{c.name}-{os.getpid()}-{time.time_ns()}' for c in cases]
+        self.futures = self.client.map(run_case, list(cases), pure=False, key=keys)
+        self.by_key = {f.key: c for f, c in zip(self.futures, cases)}
+
+    def results(self) -> Iterator[tuple[CaseSpec, dict[str, Any]]]:
+        """Yield (case, record) as cases finish."""
         from dask.distributed import as_completed as dask_completed
-        futures = self.client.map(run_case, list(cases), pure=False,
-                                  key=[f'ttb-sim-{c.name}-{os.getpid()}-{time.time_ns()}'
-                                       for c in cases])
-        by_key = {f.key: c for f, c in zip(futures, cases)}
-        for fut in dask_completed(futures, loop=self.client.loop):
-            yield by_key[fut.key], _result(by_key[fut.key], fut.result, fut.exception)
+        for fut in dask_completed(self.futures, loop=self.client.loop):
+            case = self.by_key[fut.key]
+            yield case, _result(case, fut.result, fut.exception)
 
     def close(self) -> None:
+        self.client.close()
+
+    def stop(self) -> None:
+        """Cancel the cases still queued or running on the cluster, and disconnect."""
+        if self.futures:
+            self.client.cancel(list(self.futures))
         self.client.close()
 
 
@@ -216,16 +258,35 @@ def sweep(scenario: str, *, speeds_kmh: str, seeds: int | None = None,
         f'{workers or min(len(todo), os.cpu_count() or 1)} local worker process(es)'
     if todo:
         print(f'ttb-sim: sweep: running {len(todo)} cases on {where}', file=sys.stderr)
+    main_thread = threading.current_thread() is threading.main_thread()
+    previous: dict[int, Any] = {}
+    if main_thread:   # workers start with Ctrl-C ignored (inherited): the parent handles it
+        previous[signal.SIGINT] = signal.signal(signal.SIGINT, signal.SIG_IGN)
     try:
-        for i, (case, record) in enumerate(runner.run(todo) if runner else [], start=1):
+        if runner is not None:
+            runner.submit(todo)
+        if main_thread:
+            for sig in (signal.SIGINT, signal.SIGTERM):
+                handler = signal.signal(sig, _raise_stopped)
+                previous.setdefault(sig, handler)
+        for i, (case, record) in enumerate(runner.results() if runner else [], start=1):
             records[case.name] = record
             detail = f'in {record.get("wall_time_s", 0.0) or 0.0:.1f} s' \
                 if record['status'] == 'ok' else f'{record["status"]}: {record.get("error")}'
             print(f'ttb-sim: sweep: [{i}/{len(todo)}] {case.name} {record["status"]} {detail}',
                   file=sys.stderr, flush=True)
-    finally:
         if runner is not None:
             runner.close()
+    except _Stopped as stop:
+        if runner is not None:
+            runner.stop()
+        name = 'SIGTERM' if stop.signum == signal.SIGTERM else 'SIGINT'
+        print(f'ttb-sim: stopped by {name}; {len(records)} of {len(cases)} cases finished in '
+              f'{target} (rerun the same command to resume)', file=sys.stderr)
+        return 128 + stop.signum
+    finally:
+        for signum, handler in previous.items():
+            signal.signal(signum, handler)
     rows = [case_row(records[c.name]) for c in cases if c.name in records]
     _write_csv(target / 'sweep.csv', rows)
     from ttb_sim.commands.sweep_figures import sweep_figures
