@@ -51,7 +51,7 @@ TRACK = {'model': 'slab', 'fastener_vertical_stiffness': 5e7, 'fastener_vertical
          'fastener_spacing': 0.63, 'layer_stiffness': 1.5e9, 'layer_damping': 8.3e4,
          'fasteners_per_slab': 9, 'slab_gap': 0.07}
 LAYOUT = Layout(n_spans=2, n_supports=3, n_bodies=1, n_axles=4,
-                observers=tuple(f'{k}_1' for k in OBS), piles=((1, 3), (2, 3)), soil_points=5)
+                observers=tuple(f'{k}_1' for k in OBS), piles=((1, 3), (2, 3)), soil_points=7)
 
 
 def sine(amplitude: float, frequency: float, t: np.ndarray | float,
@@ -80,10 +80,10 @@ def frame(k: int, scale: float = 1.0) -> Frame:
     pile_a[:, 2] = sine(*PILE_A, t)
     rot = np.zeros((n_piles, 3))
     rot[:, 0] = PILE_ROT[0] * 2 * math.pi * PILE_ROT[1] * math.cos(2 * math.pi * PILE_ROT[1] * t)
-    soil = np.zeros((5, 9))
-    soil[:, 0] = np.arange(5.0)
-    soil[:, 1] = 3.0
-    soil[:, 8] = sine(*SOIL, t) * (1 + np.arange(5.0))
+    soil = np.zeros((7, 9))       # a line of five points at y = 3 m, then two VAL points
+    soil[:, 0] = [0.0, 1.0, 2.0, 3.0, 4.0, 1.0, 3.0]
+    soil[:, 1] = [3.0, 3.0, 3.0, 3.0, 3.0, 5.0, 5.0]
+    soil[:, 8] = sine(*SOIL, t) * np.array([1.0, 2.0, 3.0, 4.0, 5.0, 1.0, 5.0])
     return Frame(step=k, time=t, head_position=SPEED * t, speed=SPEED, midspan=mid,
                  bearings=np.zeros((3, 2, 3)), body_acceleration=body,
                  body_angular_velocity=np.zeros((1, 3)), wheel_rail=wheel, observers=obs,

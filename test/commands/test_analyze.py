@@ -106,12 +106,13 @@ def test_girder_piles_and_soil(analysed):
     assert pile['vertical_acceleration_peak_m_s2'] == pytest.approx(sb.PILE_A[0], rel=3e-3)
     assert pile['rotation_peak_rad'] == pytest.approx(sb.PILE_ROT[0], rel=0.02)
     points = m['soil']['points']
-    assert len(points) == 3
-    first = points['point_at_0.00m']
+    assert sorted(points) == ['point_(1.0,_5.0)_m', 'point_(3.0,_5.0)_m']   # off the line
+    assert m['soil']['line_peak_acceleration_m_s2'] == pytest.approx(5 * sb.SOIL[0], rel=3e-3)
+    first = points['point_(1.0,_5.0)_m']
     level = 20 * math.log10(sb.SOIL[0] / math.sqrt(2) / 1e-6)
     assert first['val_max_db'] == pytest.approx(level, abs=1e-6)
     assert first['val_max_band_hz'] == pytest.approx(6.31, abs=0.01)
-    last = points['point_at_4.00m']   # amplitude x5
+    last = points['point_(3.0,_5.0)_m']   # amplitude x5
     assert last['val_max_db'] - first['val_max_db'] == pytest.approx(20 * math.log10(5),
                                                                      abs=1e-6)
 

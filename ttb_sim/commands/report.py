@@ -247,42 +247,69 @@ def _pile_metrics(s: Streams) -> dict[str, Any]:
     return piles
 
 
-def soil_line(s: Streams) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
-    """Return (order of points along the line, distance along it (m), az (n, points)) or None."""
-    if s.soil is None or 'az' not in s.soil_fields or 'x' not in s.soil_fields:
+def _soil_xyz(s: Streams) -> np.ndarray | None:
+    if s.soil is None or not all(c in s.soil_fields for c in ('x', 'y', 'z', 'az')):
         return None
-    pts = s.soil.values
-    xyz = np.stack([pts[0, :, s.soil_fields.index(c)] for c in ('x', 'y', 'z')], axis=-1)
-    order = np.lexsort((xyz[:, 1], xyz[:, 0]))
-    steps = np.linalg.norm(np.diff(xyz[order], axis=0), axis=1)
-    distance = np.concatenate([[0.0], np.cumsum(steps)])
-    az = pts[:, order, s.soil_fields.index('az')]
-    return order, distance, az
+    return np.stack([s.soil.values[0, :, s.soil_fields.index(c)] for c in ('x', 'y', 'z')],
+                    axis=-1).astype(float)
 
 
-def soil_points(n: int) -> list[int]:
-    """Return up to three point positions along the line: first, middle, last."""
-    return sorted({0, n // 2, n - 1}) if n else []
+def soil_line(s: Streams) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
+    """
+    Return (point indices, distance along the line (m), az (n, points)) of the observation line.
+
+    The line is the points at the first point's y and z (to 1 mm), ordered by x:
+    ttb_sim writes [P]'s observation line first, then the VAL points and the
+    user's points elsewhere.
+    """
+    xyz = _soil_xyz(s)
+    if xyz is None or s.soil is None:
+        return None
+    on = np.flatnonzero((np.abs(xyz[:, 1] - xyz[0, 1]) < 1e-3)
+                        & (np.abs(xyz[:, 2] - xyz[0, 2]) < 1e-3))
+    order = on[np.argsort(xyz[on, 0], kind='stable')]
+    distance = xyz[order, 0] - xyz[order[0], 0]
+    return order, distance, s.soil.values[:, order, s.soil_fields.index('az')]
+
+
+def soil_val_points(s: Streams) -> list[tuple[str, np.ndarray]]:
+    """
+    Return (label, vertical acceleration record) of the ground points to rate by VAL.
+
+    The points off the observation line (ttb_sim's [P] section 4.2.2 VAL points and the
+    user's points) when there are any, else the first, middle and last point of the line.
+    """
+    xyz = _soil_xyz(s)
+    line = soil_line(s)
+    if xyz is None or line is None or s.soil is None:
+        return []
+    az = s.soil.values[:, :, s.soil_fields.index('az')]
+    off = [i for i in range(xyz.shape[0]) if i not in set(line[0].tolist())]
+    if off:
+        return [(f'point ({xyz[i, 0]:.1f}, {xyz[i, 1]:.1f}) m', az[:, i]) for i in off]
+    order, distance, _ = line
+    n = order.size
+    return [(f'line point at {distance[k]:.1f} m', az[:, order[k]])
+            for k in sorted({0, n // 2, n - 1})]
 
 
 def _soil_metrics(s: Streams) -> dict[str, Any]:
     line = soil_line(s)
     if line is None or s.soil is None:
         return {}
-    _, distance, az = line
     fs = s.soil.rate
     points = {}
-    for i in soil_points(az.shape[1]):
-        centres, val = vibration_levels(az[:, i], fs)
-        points[f'point_at_{distance[i]:.2f}m'] = {
-            'vertical_acceleration_peak_m_s2': float(np.max(np.abs(az[:, i]))),
+    for label, record in soil_val_points(s):
+        centres, val = vibration_levels(record, fs)
+        points[label.replace(' ', '_')] = {
+            'vertical_acceleration_peak_m_s2': float(np.max(np.abs(record))),
             'val_band_centres_hz': [float(c) for c in centres],
             'val_db': [float(v) if math.isfinite(v) else None for v in val],
             'val_max_db': float(np.max(val)), 'val_max_band_hz': float(centres[np.argmax(val)]),
             'vl_total_db': total_level(centres, val),
             'vl_wk_db': total_level(centres, val, 'Wk'),
             'vl_wm_db': total_level(centres, val, 'Wm')}
-    return {'line_peak_acceleration_m_s2': float(np.max(np.abs(az))), 'points': points}
+    return {'line_peak_acceleration_m_s2': float(np.max(np.abs(line[2]))), 'points': points}
 
 
 # -- power flow --------------------------------------------------------------------------

@@ -36,7 +36,7 @@ from ttb_sim.analysis.psd import resolving_segment_seconds, welch_psd
 from ttb_sim.analysis.rigid_displacement import rigid_midspan_displacement
 from ttb_sim.analysis.safety import deck_acceleration
 from ttb_sim.commands.report import (bag_metrics, CAR_BODY_LOWEST_HZ, FigureNote, marks_of,
-                                     observer_stations, power_flows, soil_line, soil_points)
+                                     observer_stations, power_flows, soil_line, soil_val_points)
 from ttb_sim.commands.streams import Series, Streams
 
 log = logging.getLogger(__name__)
@@ -151,8 +151,11 @@ def girder(bags: Sequence[Streams], out: Path) -> FigureNote:
 
 
 def _pile_keys(bags: Sequence[Streams]) -> list[tuple[int, int]]:
-    keys = sorted(set().union(*(s.pile_acceleration for s in bags)))
+    keys: list[tuple[int, int]] = sorted(set().union(*(s.pile_acceleration for s in bags)))
     piers = sorted({k[0] for k in keys})[:2]
+    if len(piers) == 1:   # one group: [P]'s piles #5 and #14, else the first and the last
+        wanted = [k for k in ((piers[0], 5), (piers[0], 14)) if k in keys]
+        return wanted or sorted({keys[0], keys[-1]})
     picked = []
     for pier in piers:
         mine = [k for k in keys if k[0] == pier]
@@ -179,50 +182,47 @@ def piles(bags: Sequence[Streams], out: Path) -> FigureNote:
                       'with the excitation frequencies of the train (Eq. 19 band).')
 
 
+def _val_points(bags: Sequence[Streams]) -> list[tuple[Streams, list[tuple[str, np.ndarray]]]]:
+    return [(s, pts) for s in bags for pts in [soil_val_points(s)] if pts and s.soil is not None]
+
+
 def ground(bags: Sequence[Streams], out: Path) -> FigureNote:
-    """Ground acceleration at up to three points of the observation line: time beside PSD."""
-    lines = [(s, ln) for s in bags for ln in [soil_line(s)] if ln is not None]
-    if not lines:
-        raise Skip('no soil point cloud with az (soil/points)')
+    """Ground acceleration at the VAL points: time beside PSD."""
+    points = _val_points(bags)
+    if not points:
+        raise Skip('no soil point cloud with x, y, z, az (soil/points)')
     marks = _marks(bags)
     rows = []
-    _, d0, az0 = lines[0][1]
-    for i in soil_points(az0.shape[1]):
-        traces = []
-        for s, (_, d, az) in lines:
-            if s.soil is not None and i < az.shape[1]:
-                traces.append((s.label, s.soil, az[:, i]))
-        rows.append(_time_psd_row(f'ground point at {d0[i]:.1f} m along the line',
-                                  'vertical acceleration', 'm/s$^2$', 1.0, traces, 1.0, 100.0,
-                                  marks, logf=True))
+    for k, (label, _) in enumerate(points[0][1]):
+        traces = [(s.label, s.soil, pts[k][1]) for s, pts in points
+                  if s.soil is not None and k < len(pts)]
+        rows.append(_time_psd_row(f'ground {label}', 'vertical acceleration', 'm/s$^2$', 1.0,
+                                  traces, 1.0, 100.0, marks, logf=True))
     path = panels_figure(out / 'ground.png', 'Ground acceleration', rows)
-    return FigureNote(path.name, 'Vertical ground acceleration at the first, middle and last '
-                      'point of the soil observation line.')
+    return FigureNote(path.name, 'Vertical ground acceleration at the VAL points (off the '
+                      'observation line; else its first, middle and last point).')
 
 
 def soil_val(bags: Sequence[Streams], out: Path) -> FigureNote:
-    """VAL per 1/3 octave at up to three soil points (a0 = 1e-6 m/s^2)."""
-    lines = [(s, ln) for s in bags for ln in [soil_line(s)] if ln is not None]
-    if not lines:
-        raise Skip('no soil point cloud with az (soil/points)')
+    """VAL per 1/3 octave at the VAL points (a0 = 1e-6 m/s^2)."""
+    points = _val_points(bags)
+    if not points:
+        raise Skip('no soil point cloud with x, y, z, az (soil/points)')
     marks = _marks(bags)
     panels = []
-    _, d0, az0 = lines[0][1]
-    for i in soil_points(az0.shape[1]):
+    for k, (label, _) in enumerate(points[0][1]):
         traces = []
-        for s, (_, _, az) in lines:
-            if s.soil is not None and i < az.shape[1]:
-                c, v = vibration_levels(az[:, i], s.soil.rate)
+        for s, pts in points:
+            if s.soil is not None and k < len(pts):
+                c, v = vibration_levels(pts[k][1], s.soil.rate)
                 traces.append((s.label, c, v))
-        panels.append(Panel(f'point at {d0[i]:.1f} m along the line', '1/3-octave band centre '
-                            'frequency '
-                            '(Hz)', 'VAL (dB re 1e-6 m/s$^2$)', traces, logx=True,
-                            style='step', xlim=(0.9, 90.0), marks=marks,
-                            floor_below_top=80.0))
+        panels.append(Panel(label, '1/3-octave band centre frequency (Hz)',
+                            'VAL (dB re 1e-6 m/s$^2$)', traces, logx=True, style='step',
+                            xlim=(0.9, 90.0), marks=marks, floor_below_top=80.0))
     path = panels_figure(out / 'soil_val.png', 'Vibration acceleration level per 1/3 octave '
                          '([P] Fig. 26)', [[p] for p in panels])
     return FigureNote(path.name, 'Vertical vibration acceleration level VAL = 20 log10(a_rms '
-                      '/ 1e-6 m/s^2) per 1/3-octave band, 1-80 Hz, at the soil points.')
+                      '/ 1e-6 m/s^2) per 1/3-octave band, 1-80 Hz, at the VAL points.')
 
 
 def soil_contour(bags: Sequence[Streams], out: Path) -> list[FigureNote]:
