@@ -21,8 +21,9 @@ References and tolerances are stated per test.
 import numpy as np
 import pytest
 
-from ttb_sim.model.foundation.records import (Interface, MeshSize, Observation, PAPER_LAYERS,
-                                              PileGroup, PileLoad, SoilBlock, Substructure)
+from ttb_sim.model.foundation.records import (BlockSize, Interface, MeshSize, Observation,
+                                              PAPER_LAYERS, PileGroup, PileLoad, SoilParameters,
+                                              Substructure)
 from ttb_sim.model.foundation.substructure import build
 from ttb_sim.sim.pile_soil import (initial_state, observe, PartitionedNewmark, run,
                                    stable_time_step, states)
@@ -31,10 +32,10 @@ from ttb_sim.validation.cases.pile_soil import (boundary_reflection, head_stiffn
 
 
 def _pile(interface='desai'):
-    return Substructure(soil=SoilBlock(PAPER_LAYERS, lx=12.0, ly=12.0),
+    mesh = MeshSize(h=0.8, growth=1.5, h_max=2.5)
+    return Substructure(soil=SoilParameters(PAPER_LAYERS, BlockSize(12.0, 12.0), mesh),
                         piles=PileGroup(rows=1, cols=1, side=0.8, length=6.0),
                         interface=Interface(model=interface),
-                        mesh=MeshSize(h=0.8, growth=1.5, h_max=2.5),
                         observation=Observation(line_points=0, points=((2.0, 0.0, 0.0),)))
 
 

@@ -52,19 +52,23 @@ V16  Desai law of the V14 model at a shaft Gauss point of the middle layer,
 
 from __future__ import annotations
 
+from dataclasses import replace
 import logging
 import math
-from typing import Optional
+from typing import Optional, Sequence
 
 import numpy as np
 import scipy.linalg as sla
 from scipy.optimize import curve_fit
 
-from ttb_sim.model.foundation.records import (Interface, MeshSize, Observation, PAPER_LAYERS,
-                                              PileGroup, PileLoad, SoilBlock, SoilLayer,
+from ttb_sim.config import load_scenario, Scenario
+from ttb_sim.model.foundation.records import (BlockSize, EQUAL_AREA_SIDE, MeshSize, Observation,
+                                              PAPER_LAYERS, PileLoad, SoilLayer, SoilParameters,
                                               Substructure)
 from ttb_sim.model.foundation.substructure import build, PileSoilModel
-from ttb_sim.sim.pile_soil import observe, run, states, static_solve
+from ttb_sim.sim.frames import Frame
+from ttb_sim.sim.pile_soil import observe, states, static_solve
+from ttb_sim.sim.substructure_run import SubstructureRun
 from ttb_sim.validation.references.pile_soil import (hyperbola_stress, hyperbola_tangent,
                                                      layered_pile_stiffness,
                                                      quarter_wavelength_frequencies,
@@ -80,10 +84,9 @@ NO_POINTS = Observation(line_points=0, val_points=False)
 
 def column(layers: tuple[SoilLayer, ...], h: float, boundary: str = 'fixed') -> Substructure:
     """Return a laterally periodic soil column of bricks of size h (one brick in plan)."""
-    return Substructure(soil=SoilBlock(layers, lx=h, ly=h, boundary=boundary,  # type: ignore
-                                       periodic=True),
-                        piles=None, mesh=MeshSize(h=h, growth=1.0, h_max=h),
-                        observation=NO_POINTS)
+    soil = SoilParameters(layers, BlockSize(h, h), MeshSize(h=h, growth=1.0, h_max=h),
+                          boundary=boundary, periodic=True)
+    return Substructure(soil=soil, piles=None, observation=NO_POINTS)
 
 
 def shear_frequencies(model: PileSoilModel, n: int) -> np.ndarray:
@@ -146,50 +149,62 @@ def v13() -> list[Row]:
                 '-', 'absolute')]
 
 
+def single_pile_scenario(h: float = 0.443, growth: float = 1.3, h_max: float = 3.0,
+                         block: float = 40.0, interface: str = 'desai',
+                         max_aspect: float = 12.0, force: float = 1e3) -> Scenario:
+    """Return the built-in ``single_pile`` scenario (V14) with its mesh and block set."""
+    return load_scenario('single_pile', values=[
+        ('soil.mesh.h', h), ('soil.mesh.growth', growth), ('soil.mesh.h_max', h_max),
+        ('soil.mesh.max_aspect', max_aspect), ('soil.block.lx', block),
+        ('soil.block.ly', block), ('interface.model', interface), ('load.type', 'static'),
+        ('load.amplitude', force), ('load.direction', 'z')])
+
+
 def single_pile(h: float = 0.443, growth: float = 1.3, h_max: float = 3.0,
                 block: float = 40.0, interface: str = 'desai',
                 max_aspect: float = 12.0) -> Substructure:
     """Return the V14 single pile: d = 1.0 m, L = 12 m in the Table 5 soil."""
-    return Substructure(soil=SoilBlock(PAPER_LAYERS, lx=block, ly=block),
-                        piles=PileGroup(rows=1, cols=1, diameter=1.0, length=12.0),
-                        interface=Interface(model=interface),  # type: ignore[arg-type]
-                        mesh=MeshSize(h=h, growth=growth, h_max=h_max,
-                                      max_aspect=max_aspect),
-                        observation=NO_POINTS)
+    scenario = single_pile_scenario(h, growth, h_max, block, interface, max_aspect)
+    return replace(scenario.substructure(), observation=NO_POINTS)
+
+
+def scenario_frames(scenario: Scenario) -> tuple[SubstructureRun, list[Frame]]:
+    """Run a substructure scenario as ``ttb-sim run`` does; return the run and its frames."""
+    runner = SubstructureRun(scenario)
+    return runner, list(runner.frames())
 
 
 def head_stiffness(spec: Substructure, force: float = 1e3) -> float:
-    """Return the static vertical head stiffness F / w (N/m) through :func:`run`."""
+    """Return the static vertical head stiffness F / w (N/m) of pile 1 under a head load."""
     model = build(spec)
     state = static_solve(model, model.load_vector(PileLoad('static', force, pile=1)),
                          increments=1)
     return force / float(observe(model, state).pile_displacement[0, 2])
 
 
+def scenario_head_stiffness(scenario: Scenario) -> float:
+    """Return F / w (N/m) of the loaded pile from the static frame of a scenario run."""
+    _, frames = scenario_frames(scenario)
+    load = scenario.load
+    axis = 'xyz'.index(load.direction)
+    return load.amplitude / float(frames[0].pile_displacement[load.pile - 1, axis])
+
+
 def randolph_wroth_reference(spec: Substructure) -> float:
     """Return Randolph-Wroth for the spec's pile and layers (N/m)."""
-    assert spec.piles is not None and spec.piles.diameter is not None
+    assert spec.piles is not None
     layers = spec.soil.layers
+    diameter = spec.piles.width / EQUAL_AREA_SIDE
     return layered_pile_stiffness([la.thickness for la in layers], [la.G for la in layers],
-                                  layers[-1].nu, spec.piles.length, spec.piles.diameter,
+                                  layers[-1].nu, spec.piles.length, diameter,
                                   spec.piles.E)
 
 
 def v14() -> list[Row]:
     """Compare the static head stiffness of a single pile with Randolph-Wroth."""
-    spec = single_pile()
-    return [relative_row('V14', 'single-pile head stiffness', head_stiffness(spec),
-                         randolph_wroth_reference(spec), 0.15, 'N/m')]
-
-
-def pile_harmonic(h: float = 0.1775) -> Substructure:
-    """Return [P]'s section 3 check: 5 x 3 group, no cap, ground between piles 4 and 5."""
-    group = PileGroup()
-    c4, c5 = group.centres()[3], group.centres()[4]
-    mid = (0.5 * (c4[0] + c5[0]), c4[1], 0.0)
-    return Substructure(soil=SoilBlock(PAPER_LAYERS, lx=36.0, ly=30.0), piles=group,
-                        mesh=MeshSize(h=h, growth=1.3, h_max=2.0, h_shaft=1.0),
-                        observation=Observation(points=(mid,)))
+    scenario = single_pile_scenario()
+    return [relative_row('V14', 'single-pile head stiffness', scenario_head_stiffness(scenario),
+                         randolph_wroth_reference(scenario.substructure()), 0.15, 'N/m')]
 
 
 def split_response(t: np.ndarray, x: np.ndarray, frequency: float
@@ -230,15 +245,14 @@ def transient_frequency(t: np.ndarray, slow: np.ndarray) -> float:
         return guess
 
 
-def v15_results(h: float = 0.1775, duration: float = 2.0) -> dict[str, float]:
-    """Run pile_harmonic and return amplitudes and transient frequencies."""
-    spec = pile_harmonic(h)
-    load = PileLoad('harmonic', 10e3, 20.0, pile=5, direction='z')
-    model = build(spec, load)
-    frames = list(run(model, load, duration))
+def v15_results(overrides: Sequence[str] = ()) -> dict[str, float]:
+    """Run the built-in pile_harmonic and return amplitudes and transient frequencies."""
+    scenario = load_scenario('pile_harmonic', overrides)
+    runner, frames = scenario_frames(scenario)
+    model = runner.model
     t = np.array([f.time for f in frames])
-    pile = np.array([f.pile_displacement[4, 2] for f in frames])
-    ground = np.array([f.soil_displacement[-1, 2] for f in frames])
+    pile = np.array([f.pile_displacement[scenario.load.pile - 1, 2] for f in frames])
+    ground = np.array([f.soil_points[-1, 5] for f in frames])  # the user point, uz
     amp_p, slow_p = split_response(t, pile, 20.0)
     amp_g, slow_g = split_response(t, ground, 20.0)
     return {'pile_amplitude': amp_p, 'ground_amplitude': amp_g,
