@@ -135,8 +135,8 @@ def panels_figure(path: Path, title: str, rows: Sequence[Sequence[Panel]]) -> Pa
     fig.suptitle(title, fontsize=11)
     axes = fig.subplots(n_rows, n_cols, squeeze=False)
     # a fixed layout in inches (constrained layout costs seconds per figure)
-    fig.subplots_adjust(left=0.85 / width, right=1 - 0.25 / width, bottom=0.55 / height,
-                        top=1 - 0.85 / height, wspace=1.0 / (6.0 - 1.0),
+    fig.subplots_adjust(left=1.05 / width, right=1 - 0.25 / width, bottom=0.55 / height,
+                        top=1 - 0.85 / height, wspace=1.2 / (6.0 - 1.2),
                         hspace=0.9 / (3.4 - 0.9))
     legend_done = False   # the excitation marks are explained once, in the first panel
     for i, row in enumerate(rows):
@@ -154,7 +154,7 @@ def contour_figure(path: Path, title: str, t: np.ndarray, s: np.ndarray, values:
                    xlabel: str, ylabel: str, colour_label: str) -> Path:
     """Write a space-time contour (values (len(t), len(s))) to a PNG, symmetric colour scale."""
     fig = Figure(figsize=(8.0, 4.5))
-    fig.subplots_adjust(left=0.1, right=0.97, bottom=0.12, top=0.9)
+    fig.subplots_adjust(left=0.1, right=0.97, bottom=0.12, top=0.86)
     fig.suptitle(title, fontsize=11)
     ax = fig.subplots()
     peak = float(np.nanmax(np.abs(values))) or 1.0

@@ -64,7 +64,10 @@ class FigureNote:
 # -- excitation marks ---------------------------------------------------------------------
 
 def marks_of(s: Streams) -> list[Excitation]:
-    """Return the excitation frequencies of a bag's train (from its speed and scenario echo)."""
+    """Return the excitation frequencies of a bag (train speed, scenario echo, harmonic load)."""
+    load = s.section('load')
+    if load.get('type') == 'harmonic' and load.get('frequency'):
+        return [Excitation('harmonic load', float(load['frequency']), float(load['frequency']))]
     if not s.speed:
         return []
     car, train = s.section('car'), s.section('train')

@@ -241,8 +241,8 @@ def soil_contour(bags: Sequence[Streams], out: Path) -> list[FigureNote]:
             f'{ends[1, y]:.1f}) m'
         name = 'soil_contour.png' if len(bags) == 1 else \
             f'soil_contour_{re.sub(r"[^A-Za-z0-9_.-]", "_", s.label)}.png'
-        contour_figure(out / name, f'Ground vertical acceleration along the observation line '
-                       f'{where}, {s.label} ([P] Fig. 25)', s.soil.t, distance, az,
+        contour_figure(out / name, 'Ground vertical acceleration along the observation line '
+                       f'([P] Fig. 25)\n{s.label}: line {where}', s.soil.t, distance, az,
                        'time t (s)', 'distance along the observation line (m)',
                        'vertical acceleration (m/s$^2$)')
         notes.append(FigureNote(name, f'{s.label}: vertical ground acceleration along the soil '
