@@ -159,3 +159,16 @@ def test_soil_points_are_in_the_cloud_with_their_positions(tmp_path: Path) -> No
 def test_the_scenario_layer_refuses_a_load_on_no_pile() -> None:
     with pytest.raises(ScenarioError, match=r'load\.pile = 16; allowed: 1 \.\. 15'):
         load_scenario('pile_harmonic', ['load.pile=16'])
+
+
+def test_a_displacement_over_the_limit_stops_the_run_with_a_readable_bag(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    out = tmp_path / 'diverged'
+    args = _sets('load.type=harmonic', 'load.frequency=4', 'solver.divergence_limit=1e-7')
+    assert main(['run', 'single_pile', '--out', str(out), '--duration', '1', *args]) == 1
+    assert 'solver.divergence_limit' in capsys.readouterr().err
+    summary = json.loads((out / 'summary.json').read_text())
+    assert summary['status'] == 'diverged' and 0 < summary['frames'] < 201
+    bag = read_bag(out)
+    head = bag['/ttb_sim/piles/pier01/pile01/displacement'].component('vector', 'z')
+    assert len(head) == summary['frames'] and np.abs(head).max() <= 1e-7
