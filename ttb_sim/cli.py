@@ -147,12 +147,24 @@ def entry() -> None:
     Unlike :func:`main`, the one-line SIGINT / SIGTERM handler stays installed until
     the process exits, so a signal that arrives after the verb has finished (its
     output is complete) still ends in one line and exit 128 + signal, never in a
-    ``KeyboardInterrupt`` traceback during shutdown.
+    ``KeyboardInterrupt`` traceback during shutdown; and the process ends with
+    ``os._exit`` once the verb has returned and the output is flushed.
     """
     if threading.current_thread() is threading.main_thread():
         for sig in (signal.SIGINT, signal.SIGTERM):
             signal.signal(sig, _stop_now)
-    sys.exit(_main(sys.argv[1:]))
+    try:
+        code = _main(sys.argv[1:])
+    except SystemExit as exc:  # argparse's own exits (usage errors, --help)
+        code = exc.code if isinstance(exc.code, int) else (0 if exc.code is None else 2)
+    # The verb has closed its files. Ending here skips the interpreter's finalisation, which
+    # restores the default signal dispositions and then tears down the imported extension
+    # modules (numba/LLVM, BLAS) for a second or more under load: a Ctrl-C in that window
+    # used to kill the finished process by SIGINT (exit -2), hiding its exit code.
+    logging.shutdown()
+    sys.stdout.flush()
+    sys.stderr.flush()
+    os._exit(code)
 
 
 def _main(argv: Sequence[str] | None) -> int:

@@ -31,6 +31,7 @@ import time
 
 import pytest
 from ttb_sim.cli import main
+from ttb_sim.config import builtin_scenarios
 from ttb_sim.io.bag import check_destination
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -127,17 +128,27 @@ def test_missing_parents_are_made(tmp_path: Path, capsys) -> None:
     assert summary['setup_time'] > 0.0
 
 
-def test_the_program_keeps_its_one_line_handler_until_it_exits(tmp_path: Path) -> None:
-    """A signal after the verb has finished still ends in one line, not a traceback."""
+@pytest.mark.parametrize('argv, expected', [(['scenarios'], 0), (['run'], 2)])
+def test_the_program_ends_when_its_verb_returns(tmp_path: Path, argv: list[str],
+                                                expected: int) -> None:
+    """
+    No interpreter finalisation after the verb: its exit code, complete output, no window.
+
+    Finalisation restores the default signal dispositions and tears down the extension
+    modules; a Ctrl-C there killed a finished run by SIGINT (exit -2). The program now
+    ends with os._exit once the verb has returned and the output is flushed, so atexit
+    hooks never run, and the one-line handler is in place until that moment.
+    """
     code = ('import atexit, signal, sys\n'
-            'atexit.register(lambda: print("handler", signal.getsignal(signal.SIGINT).__name__,'
-            ' file=sys.stderr))\n'
-            'sys.argv = ["ttb-sim", "scenarios"]\n'
+            'atexit.register(lambda: print("finalised", file=sys.stderr))\n'
+            f'sys.argv = ["ttb-sim", *{argv!r}]\n'
             'from ttb_sim.cli import entry\n'
             'entry()\n')
     env = {**os.environ, 'PYTHONPATH': os.pathsep.join(
         [str(ROOT), os.environ.get('PYTHONPATH', '')])}
     done = subprocess.run([sys.executable, '-c', code], capture_output=True, text=True,
                           env=env, timeout=HANG_BOUND, check=False)
-    assert done.returncode == 0, done.stderr
-    assert 'handler _stop_now' in done.stderr
+    assert done.returncode == expected, done.stderr
+    assert 'finalised' not in done.stderr
+    if expected == 0:  # the output was flushed before the process ended
+        assert all(name in done.stdout for name in builtin_scenarios())
