@@ -178,7 +178,6 @@ class QuarterCarCoupling:
         v_new, a_new = nm.finish(u_new, h_v, h_a)
         return u_new, v_new, a_new
 
-
     def _step_green(self, u: np.ndarray, force: np.ndarray, h_v: np.ndarray, h_a: np.ndarray,
                     dofs: np.ndarray, n0: np.ndarray, w: np.ndarray, b: np.ndarray,
                     p: np.ndarray, e: np.ndarray, hs_v: np.ndarray,
