@@ -218,7 +218,11 @@ class PassageController:
             return f'{self.state} at t = {self._node_time:.3f} s'
 
     def close(self) -> None:
-        """Stop stepping for good and close the recorder (idempotent)."""
+        """
+        Stop stepping for good and close the recorder (idempotent).
+
+        Call it on the thread that steps (the one that writes the recorder).
+        """
         with self._lock:
             self.state = 'stopped'
             self._close_recorder()
@@ -228,6 +232,11 @@ class PassageController:
     @property
     def _node_time(self) -> float:
         return self.last_frame.time if self.last_frame is not None else self.time_offset
+
+    @property
+    def node_time(self) -> float:
+        """The node's simulation time (s): the latest frame's, continuous over passages."""
+        return self._node_time
 
     @property
     def frame_period(self) -> float:
