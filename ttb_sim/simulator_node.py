@@ -30,7 +30,7 @@ Threads:
   ``real_time_factor``, writes every frame to the bag and closes it: the bag lives
   on this one thread (SQLite requires it);
 - the publishing thread (:class:`~ttb_sim.node.publishing.PublishLoop`) turns the
-  frames due at ``publish_rate_hz`` into messages, within 40 % of the wall clock,
+  frames due at ``publish_rate_hz`` into messages, within 30 % of the wall clock,
   dropping (and counting) frames it cannot keep up with instead of slowing the
   stepping.
 
@@ -94,7 +94,7 @@ from visualization_msgs.msg import Marker, MarkerArray
 
 STEP_BUDGET = 0.02
 """Wall-clock seconds one stepping tick may spend before it hands its frames on."""
-PUBLISH_DUTY = 0.4
+PUBLISH_DUTY = 0.3
 """Largest share of the wall clock the publishing thread may take."""
 PAUSED_CLOCK_PERIOD = 0.1
 """Wall-clock seconds between two /clock messages while paused or idle."""
@@ -164,8 +164,8 @@ class SimulatorNode(Node):
 
     The constructor validates everything a user gives at start-up (scenario,
     parameter values and types, bag destination) and returns at once; the model
-    is built on the stepping thread. :attr:`fatal` completes with a message if
-    that build fails.
+    is built on the stepping thread. :attr:`fatal` completes with ``(message,
+    exit code)`` if that build fails (or stepping ends on an unexpected error).
 
     Parameters
     ----------
@@ -187,14 +187,14 @@ class SimulatorNode(Node):
         self.topics: list[Topic] = []
         self.publishers_by_name: dict[str, Any] = {}
         self.fatal = Future()
-        self._fatal_message = ''
+        self._fatal: tuple[str, int] = ('', 0)
         self._clock_lock = threading.Lock()
         self._last_clock = -1
         self._last_build_log = 0.0
         self._closed = False
         try:
             self._configure()
-        except (ScenarioError, ModelError):
+        except BaseException:   # a bad value, or Ctrl-C in the middle of the set-up
             self.close()
             self.destroy_node()
             raise
@@ -280,14 +280,14 @@ class SimulatorNode(Node):
         self.get_logger().info(f'recording to {path} ({storage})')
         return recorder
 
-    def _stepper_failed(self, message: str) -> None:
+    def _stepper_failed(self, message: str, code: int) -> None:
         """Hand a build failure to the executor (runs on the stepping thread)."""
-        self._fatal_message = message
+        self._fatal = (message, code)
         self._failed_guard.trigger()
 
     def _on_failed(self) -> None:
         if not self.fatal.done():
-            self.fatal.set_result(self._fatal_message)
+            self.fatal.set_result(self._fatal)
 
     def _on_built(self) -> None:
         """Create the topic-table publishers (on the executor) and start publishing."""
@@ -469,7 +469,8 @@ class SimulatorNode(Node):
         self._closed = True
         if self.publish_loop is not None:
             self.publish_loop.stop()
-        if self.stepper is not None and not self.stepper.stop(timeout=10.0):
+        building = self.stepper is not None and self.stepper.status().state == 'building'
+        if self.stepper is not None and not self.stepper.stop(timeout=1.0 if building else 10.0):
             self.get_logger().warning('the model is still being built; leaving it behind '
                                       '(no bag was open yet)')
 
@@ -542,8 +543,8 @@ def main(args: list[str] | None = None) -> int:
         executor.add_node(node)
         executor.spin_until_future_complete(node.fatal)
         if node.fatal.done():
-            logger.fatal(str(node.fatal.result()))
-            code = 2
+            message, code = node.fatal.result()
+            logger.fatal(message)
     except (KeyboardInterrupt, ExternalShutdownException):
         pass
     except (ScenarioError, ModelError) as exc:

@@ -162,11 +162,12 @@ def test_a_failed_build_is_reported_once_and_ends_the_thread(beam: Scenario) -> 
     bad = load_scenario('moving_force_beam', [], [('solver.dt', 1e-6),
                                                   ('solver.duration', 1e4)])
     failures: list[str] = []
-    stepper = Stepper(bad, values_for(bad), on_tick=Ticks(), on_failed=failures.append)
+    stepper = Stepper(bad, values_for(bad), on_tick=Ticks(),
+                      on_failed=lambda message, code: failures.append((message, code)))
     stepper.start()
     wait_for(lambda: not stepper.alive)
     status = stepper.status()
-    assert status.state == 'failed' and failures == [status.error]
+    assert status.state == 'failed' and failures == [(status.error, 2)]
     assert 'solver.dt' in status.error and "'moving_force_beam'" in status.error
 
 
@@ -178,7 +179,7 @@ def test_a_recorder_that_cannot_open_fails_without_stepping(beam: Scenario,
     ticks = Ticks()
     failures: list[str] = []
     stepper = Stepper(beam, values_for(beam), on_tick=ticks, open_recorder=open_recorder,
-                      on_failed=failures.append)
+                      on_failed=lambda message, code: failures.append(message))
     stepper.start()
     stepper.publishing_ready()
     wait_for(lambda: not stepper.alive)

@@ -94,7 +94,8 @@ class Stepper:
         Called on the thread once the controller exists (e.g. to create the
         publishers of its topic table on the executor).
     on_failed : callable, optional
-        Called on the thread with the message when building or opening fails.
+        Called on the thread as ``on_failed(message, code)`` when building or opening
+        fails (code 2: the scenario or the bag destination; 1: anything else).
     budget : float
         Wall-clock seconds of one stepping tick.
     clock : callable
@@ -106,7 +107,7 @@ class Stepper:
                  on_tick: Callable[[Tick], None],
                  open_recorder: Callable[[Layout], FrameSink] | None = None,
                  on_built: Callable[[PassageController], None] | None = None,
-                 on_failed: Callable[[str], None] | None = None,
+                 on_failed: Callable[[str, int], None] | None = None,
                  budget: float = 0.02,
                  clock: Callable[[], float] = time.monotonic) -> None:
         self.scenario = scenario
@@ -188,12 +189,12 @@ class Stepper:
 
     # -- the thread ---------------------------------------------------------------------
 
-    def _fail(self, message: str) -> None:
+    def _fail(self, message: str, code: int) -> None:
         with self._lock:
             self._state, self._error = 'failed', message
         log.error(message)
         if self._on_failed is not None:
-            self._on_failed(message)
+            self._on_failed(message, code)
 
     def _run(self) -> None:
         controller = self._build()
@@ -212,7 +213,7 @@ class Stepper:
                     self._wake.wait(wait)
                     self._wake.clear()
         except Exception as exc:  # noqa: B902 - a failure ends stepping, never the node
-            self._fail(f'stepping stopped: {type(exc).__name__}: {exc}')
+            self._fail(f'stepping stopped: {type(exc).__name__}: {exc}', 1)
         finally:
             controller.close()   # closes the recorder on the thread that opened it
             with self._lock:
@@ -227,11 +228,11 @@ class Stepper:
                 values = dict(self.values)
             controller = PassageController(self.scenario, values, clock=self._clock)
         except TtbSimError as exc:
-            self._fail(f'cannot build scenario {self.scenario.name!r}: {exc}')
+            self._fail(f'cannot build scenario {self.scenario.name!r}: {exc}', 2)
             return None
         except Exception as exc:  # noqa: B902 - reported as a failed build, not a traceback
             self._fail(f'building scenario {self.scenario.name!r} failed: '
-                       f'{type(exc).__name__}: {exc}')
+                       f'{type(exc).__name__}: {exc}', 1)
             return None
         if self._stop.is_set():
             controller.close()
@@ -241,7 +242,7 @@ class Stepper:
                 controller.recorder = self._open_recorder(controller.layout)
             except TtbSimError as exc:
                 controller.close()
-                self._fail(str(exc))
+                self._fail(str(exc), 2)
                 return None
         with self._lock:
             for name, value in self._pending:
