@@ -55,7 +55,7 @@ class ListRecorder:
 
 def controller(scenario: Scenario, recorder=None, clock=None, **values) -> PassageController:
     table = parameter_table(scenario)
-    given = {'real_time_factor': 0.0}
+    given = {'real_time_factor': 0.0, 'loop': False}   # the node loops by default
     given.update(values)
     kwargs = {'recorder': recorder}
     if clock is not None:
