@@ -277,8 +277,13 @@ class SimulatorNode(Node):
         make_parents(path)
         recorder = BagRecorder(path, topic_table(layout), storage,
                                namespace=self.namespace).__enter__()
-        self.get_logger().info(f'recording to {path} ({storage})')
+        self._log('info', f'recording to {path} ({storage})')
         return recorder
+
+    def _log(self, level: str, message: str) -> None:
+        """Log through rclpy while the context is valid (never after shutdown: no rosout)."""
+        if self.context.ok() and not self._closed:
+            getattr(self.get_logger(), level)(message)
 
     def _stepper_failed(self, message: str, code: int) -> None:
         """Hand a build failure to the executor (runs on the stepping thread)."""
@@ -377,11 +382,11 @@ class SimulatorNode(Node):
     def _on_tick(self, tick: Tick) -> None:
         """Log passage events and hand the frames to the publisher (stepping thread)."""
         if 'diverged' in tick.events and self.controller is not None:
-            self.get_logger().error(f'{self.controller.divergence}; stepping stopped, bag '
-                                    'closed; call ~/reset to restart')
+            self._log('error', f'{self.controller.divergence}; stepping stopped, bag closed; '
+                      'call ~/reset to restart')
         if 'idle' in tick.events:
-            self.get_logger().info('the train has left: idle (set loop:=true or call '
-                                   '~/reset for another passage)')
+            self._log('info', 'the train has left: idle (set loop:=true or call ~/reset for '
+                      'another passage)')
         if self.publish_loop is not None:
             self.publish_loop.offer(tick.frames, tick.markers)
 
@@ -405,7 +410,7 @@ class SimulatorNode(Node):
         except Exception as exc:  # noqa: B902 - shutting down under our feet
             if self.context.ok() and not self._closed:
                 raise
-            self.get_logger().debug(f'publishing stopped at shutdown: {exc}')
+            self._log('debug', f'publishing stopped at shutdown: {exc}')
 
     def _publish_clock(self, stamp_ns: int) -> None:
         """Publish /clock unless that would go back in time (from any thread)."""
@@ -466,13 +471,13 @@ class SimulatorNode(Node):
 
     def close(self) -> None:
         """Stop publishing, then stepping; the bag is closed on the stepping thread."""
-        self._closed = True
+        self._closed = True   # from here on nothing is published or logged through rclpy
         if self.publish_loop is not None:
             self.publish_loop.stop()
         building = self.stepper is not None and self.stepper.status().state == 'building'
         if self.stepper is not None and not self.stepper.stop(timeout=1.0 if building else 10.0):
-            self.get_logger().warning('the model is still being built; leaving it behind '
-                                      '(no bag was open yet)')
+            self._log('warning', 'the model is still being built; leaving it behind (no bag '
+                      'was open yet)')
 
 
 def marker_array(marker_set: MarkerSet) -> MarkerArray:
