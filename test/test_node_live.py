@@ -66,7 +66,7 @@ def node_command() -> list[str]:
                            timeout=60)
     if found.returncode == 0:
         return [ROS2, 'run', 'ttb_sim', 'simulator']
-    return [sys.executable, '-m', 'ttb_sim.simulator_node']
+    return [sys.executable, '-m', 'ttb_sim.simulator']
 
 
 def ros_env() -> dict[str, str]:
@@ -283,8 +283,8 @@ def test_five_ctrl_c_in_a_row_exit_0_without_traceback(tmp_path: Path, probe: Pr
     clock = probe.collect(Clock, '/clock')
     for k in range(5):
         node = NodeProcess(tmp_path)
-        if k == 0:
-            time.sleep(0.3)        # during start-up or the build
+        if k == 0:   # during (or right after) the build
+            wait_for(lambda: 'building model' in node.output(), proc=node)
         else:
             n = len(clock)
             wait_for(lambda: len(clock) > n, proc=node)   # while streaming
