@@ -76,6 +76,7 @@ def ros_env() -> dict[str, str]:
     env['PYTHONPATH'] = os.pathsep.join([str(ROOT)] + [p for p in env.get(
         'PYTHONPATH', '').split(os.pathsep) if p])
     env['PYTHONUNBUFFERED'] = '1'
+    env['PYTHONFAULTHANDLER'] = '1'
     return env
 
 
@@ -102,6 +103,8 @@ class NodeProcess:
         try:
             code = self.proc.wait(timeout=TIMEOUT)
         except subprocess.TimeoutExpired:
+            os.killpg(self.proc.pid, signal.SIGABRT)   # faulthandler: every thread's stack
+            time.sleep(1.0)
             os.killpg(self.proc.pid, signal.SIGKILL)
             self.proc.wait()
             pytest.fail(f'the node did not end within {TIMEOUT} s:\n{self.output()}')

@@ -19,8 +19,14 @@ It imports the node only inside :func:`main`, so that a Ctrl-C while rclpy, nump
 and scipy are still being imported (the first second or two) ends the process
 quietly with exit code 0, like a Ctrl-C at any later moment, instead of a
 ``KeyboardInterrupt`` traceback from the import machinery.
+
+Once the node has shut down (bag closed, node destroyed, rclpy shut down) the
+process ends with :func:`os._exit`: a worker thread of rclpy's
+``MultiThreadedExecutor`` pool was seen to keep the interpreter waiting for ever
+at exit after a Ctrl-C during the model build, and nothing is left to flush.
 """
 
+import os
 import sys
 
 
@@ -28,10 +34,16 @@ def main() -> int:
     """Run :func:`ttb_sim.simulator_node.main`; a Ctrl-C at any moment exits 0."""
     try:
         from ttb_sim.simulator_node import main as node_main
-        return node_main()
+        code = node_main()
     except KeyboardInterrupt:
-        return 0
+        code = 0
+    for stream in (sys.stdout, sys.stderr):
+        try:
+            stream.flush()
+        except (OSError, ValueError):   # a closed pipe: nothing more to say
+            pass
+    os._exit(code)
 
 
 if __name__ == '__main__':
-    sys.exit(main())
+    main()
