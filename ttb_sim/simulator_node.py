@@ -30,7 +30,7 @@ Threads:
   ``real_time_factor``, writes every frame to the bag and closes it: the bag lives
   on this one thread (SQLite requires it);
 - the publishing thread (:class:`~ttb_sim.node.publishing.PublishLoop`) turns the
-  frames due at ``publish_rate_hz`` into messages, within 30 % of the wall clock,
+  frames due at ``publish_rate_hz`` into messages, within 20 % of the wall clock,
   dropping (and counting) frames it cannot keep up with instead of slowing the
   stepping.
 
@@ -94,7 +94,7 @@ from visualization_msgs.msg import Marker, MarkerArray
 
 STEP_BUDGET = 0.02
 """Wall-clock seconds one stepping tick may spend before it hands its frames on."""
-PUBLISH_DUTY = 0.3
+PUBLISH_DUTY = 0.2
 """Largest share of the wall clock the publishing thread may take."""
 PAUSED_CLOCK_PERIOD = 0.1
 """Wall-clock seconds between two /clock messages while paused or idle."""
