@@ -55,6 +55,7 @@ parameter values and types, bag destination) are one FATAL line and exit code 2.
 from __future__ import annotations
 
 import functools
+import logging
 from pathlib import Path
 import sys
 import threading
@@ -117,6 +118,26 @@ _PARAM_TYPES = {'bool': ParameterType.PARAMETER_BOOL,
                 'integer': ParameterType.PARAMETER_INTEGER,
                 'double': ParameterType.PARAMETER_DOUBLE,
                 'string': ParameterType.PARAMETER_STRING}
+
+
+class OnceFilter(logging.Filter):
+    """Let each distinct log message through once (a model warning, not once per passage)."""
+
+    def __init__(self) -> None:
+        super().__init__()
+        self._seen: set[str] = set()
+
+    def filter(self, record: logging.LogRecord) -> bool:  # noqa: A003 - logging API
+        """Return True the first time a message is seen."""
+        message = record.getMessage()
+        if message in self._seen:
+            return False
+        self._seen.add(message)
+        return True
+
+
+ONCE_LOGGERS = ('ttb_sim.sim.simulation',)
+"""Loggers of the model whose warnings repeat with every passage (each builds the model)."""
 
 
 @functools.lru_cache(maxsize=None)
@@ -220,6 +241,10 @@ class SimulatorNode(Node):
                                 f'{param.allowed()})') from None
 
     def _configure(self) -> None:
+        for name in ONCE_LOGGERS:
+            logger = logging.getLogger(name)
+            if not any(isinstance(f, OnceFilter) for f in logger.filters):
+                logger.addFilter(OnceFilter())
         first = parameter_table()['scenario']
         source = self._declare('scenario', DEFAULT_SCENARIO, first)
         scenario = load_scenario(source)
