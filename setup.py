@@ -33,12 +33,20 @@ setup(
     python_requires='>=3.10',
     install_requires=['setuptools', 'numpy>=1.24', 'scipy>=1.10', 'rosbags>=0.10',
                       'PyYAML>=6', 'tqdm>=4.60',
+                      # ttb-sim analyze / compare / sweep figures (Agg back-end, no display)
+                      'matplotlib>=3.6',
                       # solver.variant (README, Benchmark); each is optional at run time:
                       # without it the variants fall back to scipy / leave BLAS threads as
                       # they are.
-                      'cholespy>=2.0', 'qdldl>=0.1.7', 'threadpoolctl>=3'],
+                      'cholespy>=2.0', 'qdldl>=0.1.7', 'threadpoolctl>=3',
+                      # compiled kernels of the lean step (ttb_sim/sim/kernels.py); without
+                      # it the numpy twins run.
+                      'numba>=0.59'],
     extras_require={
-        'test': ['pytest>=7', 'mcap>=1.1', 'mcap-ros2-support>=0.5', 'flake8>=6',
+        # ttb-sim sweep --scheduler ADDRESS (a Dask distributed cluster)
+        'dask': ['dask[distributed]>=2023.1'],
+        'test': ['dask[distributed]>=2023.1',
+                 'pytest>=7', 'mcap>=1.1', 'mcap-ros2-support>=0.5', 'flake8>=6',
                  'flake8-quotes', 'flake8-import-order', 'flake8-builtins',
                  'flake8-comprehensions', 'flake8-class-newline', 'flake8-blind-except',
                  'flake8-deprecated', 'flake8-docstrings', 'pydocstyle>=6',

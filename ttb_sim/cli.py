@@ -43,7 +43,8 @@ EXIT_OK, EXIT_FAILURE, EXIT_USAGE, EXIT_INTERRUPTED = 0, 1, 2, 130
 
 def _parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(prog='ttb-sim', description='Train-track-bridge dynamics: '
-                                'run scenarios offline to rosbag2, validate the physics.')
+                                'run scenarios offline to rosbag2, validate the physics, '
+                                'analyse bags, sweep speeds and seeds.')
     p.add_argument('--version', action='version', version=f'%(prog)s {__version__}')
     p.add_argument('-v', '--verbose', action='store_true', help='log progress details')
     sub = p.add_subparsers(dest='command', required=True, metavar='COMMAND')
@@ -81,6 +82,38 @@ def _parser() -> argparse.ArgumentParser:
                     'process (peak memory is then not per run)')
     be.add_argument('--set', dest='overrides', action='append', default=[],
                     metavar='KEY=VALUE', help='override a scenario key; repeatable')
+
+    an = sub.add_parser('analyze', help='figures, metrics.json and index.html from a bag')
+    an.add_argument('bag', help='bag directory (metadata.yaml + .mcap/.db3) or storage file')
+    an.add_argument('--out', type=Path, help='output folder (default: BAG/analysis)')
+
+    co = sub.add_parser('compare', help='the analysis figures of several bags overlaid, with a '
+                        'table of differences')
+    co.add_argument('bags', nargs='+', metavar='BAG', help='two or more bags')
+    co.add_argument('--labels', help='comma-separated labels, one per bag (default: folder '
+                    'names)')
+    co.add_argument('--out', type=Path, help='output folder (default: a new folder under '
+                    './runs/)')
+
+    sw = sub.add_parser('sweep', help='run a scenario at several speeds and seeds in parallel '
+                        '(local processes or a Dask cluster), with an aggregate table')
+    sw.add_argument('scenario', help='YAML path or built-in name')
+    sw.add_argument('--speeds-kmh', required=True, help='comma-separated speeds, e.g. '
+                    '250,300,350,400')
+    sw.add_argument('--seeds', type=int, help='irregularity seeds 1..N per speed (default: the '
+                    "scenario's seed)")
+    sw.add_argument('--set', dest='overrides', action='append', default=[],
+                    metavar='KEY=VALUE', help='override a scenario key; repeatable')
+    sw.add_argument('--duration', type=float, help='override solver.duration (s)')
+    sw.add_argument('--storage', default='mcap', choices=('mcap', 'sqlite3'))
+    sw.add_argument('--out', type=Path, help='sweep folder (default ./runs/sweep-NAME); a '
+                    'rerun with the same folder skips finished cases')
+    where = sw.add_mutually_exclusive_group()
+    where.add_argument('--workers', type=int, help='local worker processes (default: the '
+                       'number of cores, at most the number of cases)')
+    where.add_argument('--scheduler', metavar='ADDRESS', help='Dask scheduler, e.g. '
+                       "tcp://host:8786 (pip install 'ttb_sim[dask]')")
+    sw.add_argument('--force', action='store_true', help='run cases above the step budget')
 
     sc = sub.add_parser('scenarios', help='list the built-in scenarios')
     sc.add_argument('--keys', action='store_true',
@@ -136,6 +169,18 @@ def _main(argv: Sequence[str] | None) -> int:
         if args.command == 'validate':
             from ttb_sim.commands.validate import validate
             return validate(args.cases, list_only=args.list)
+        if args.command == 'analyze':
+            from ttb_sim.commands.analyze import analyze
+            return analyze(args.bag, out=args.out)
+        if args.command == 'compare':
+            from ttb_sim.commands.compare import compare
+            return compare(args.bags, labels=args.labels, out=args.out)
+        if args.command == 'sweep':
+            from ttb_sim.commands.sweep import sweep
+            return sweep(args.scenario, speeds_kmh=args.speeds_kmh, seeds=args.seeds,
+                         overrides=args.overrides, out=args.out, workers=args.workers,
+                         scheduler=args.scheduler, duration=args.duration,
+                         storage=args.storage, force=args.force)
         if args.command == 'bench':
             from ttb_sim.commands.bench import bench_command
             return bench_command(args.scenarios, variants=args.variants,

@@ -112,7 +112,7 @@ def param(default: Any, unit: str, description: str, *, low: float | None = None
     return field(default=default, metadata={'spec': spec})
 
 
-def check_declared(record: Any, what: str) -> None:
+def check_declared(record: Any, what: str, error: type[ModelError] = ModelError) -> None:
     """
     Check every declared field of a record instance against its :class:`Spec`.
 
@@ -125,7 +125,11 @@ def check_declared(record: Any, what: str) -> None:
     record
         A dataclass instance whose fields were declared with :func:`param`.
     what
-        How to name the record in messages, e.g. ``'car parameter'``.
+        How to name the record in messages, e.g. ``'car parameter'``; a name
+        ending in '.' is a key prefix (``'piles.'`` names ``piles.nu``).
+    error
+        The exception raised (a :class:`ModelError` subclass of the record's
+        component).
 
     Raises
     ------
@@ -138,19 +142,18 @@ def check_declared(record: Any, what: str) -> None:
         if spec is None:
             continue
         value = getattr(record, f.name)
+        name = f'{what}{f.name}' if what.endswith('.') else f'{what} {f.name}'
         kind = f.type if isinstance(f.type, str) else getattr(f.type, '__name__', '')
         if kind == 'bool':
             if not isinstance(value, bool):
-                raise ModelError(f'{what} {f.name} = {shown(value)} is invalid; allowed: true or '
-                                 'false')
+                raise error(f'{name} = {shown(value)} is invalid; allowed: true or false')
         elif kind in ('int', 'float'):
             number = isinstance(value, (int, float)) and not isinstance(value, bool)
             if kind == 'int' and not isinstance(value, int):
                 number = False
             if not number or not math.isfinite(value) or not spec.contains(value):
                 integer = 'an integer in ' if kind == 'int' else ''
-                raise ModelError(f'{what} {f.name} = {shown(value)} is invalid; allowed: '
-                                 f'{integer}{spec.allowed()}')
+                raise error(f'{name} = {shown(value)} is invalid; allowed: '
+                            f'{integer}{spec.allowed()}')
         elif kind == 'str' and spec.choices is not None and value not in spec.choices:
-            raise ModelError(f'{what} {f.name} = {shown(value)} is invalid; allowed: '
-                             f'{spec.allowed()}')
+            raise error(f'{name} = {shown(value)} is invalid; allowed: {spec.allowed()}')

@@ -37,3 +37,17 @@ def test_markers_describe_girders_supports_and_train():
     assert full.frame_id == 'track' and len(full.boxes) == len(boxes) + len(train)
     ids = [(b.ns, b.marker_id) for b in full.boxes]
     assert len(ids) == len(set(ids))
+
+
+def test_a_pile_group_is_drawn_instead_of_the_bridge():
+    scenario = load_scenario('pile_harmonic', ['cap.enabled=true'])
+    full = markers(scenario, 0.0)
+    piles = [b for b in full.boxes if b.ns == 'piles']
+    assert len(piles) == 15 and not [b for b in full.boxes if b.ns in ('girders', 'train')]
+    first, fifth = piles[0], piles[4]
+    assert first.position[:2] == pytest.approx((-6.0, -3.0))  # smallest x and y first
+    assert fifth.position[:2] == pytest.approx((6.0, -3.0))   # x runs fastest
+    assert first.size == pytest.approx((0.886227, 0.886227, 12.0), rel=1e-5)
+    (soil,) = [b for b in full.boxes if b.ns == 'soil']
+    assert soil.size == pytest.approx((36.0, 30.0, 22.0)) and soil.position[2] == -11.0
+    assert [b.ns for b in full.boxes].count('cap') == 1

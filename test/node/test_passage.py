@@ -299,3 +299,21 @@ def test_markers_refresh_is_throttled(beam):
     assert not c.advance().markers
     clock.now += 0.06
     assert c.advance().markers
+
+
+def test_a_substructure_scenario_streams_its_piles_and_soil_points(tmp_path: Path):
+    """scenario:=single_pile (coarse, harmonic): frames carry piles and ground; speed is inert."""
+    scenario = load_scenario('single_pile', [
+        'soil.block.lx=12', 'soil.block.ly=12', 'soil.mesh.h=0.8', 'soil.mesh.growth=1.5',
+        'soil.mesh.h_max=2.5', 'piles.side=0.8', 'piles.length=6', 'load.type=harmonic',
+        'load.frequency=4', 'output.rate_hz=100', 'solver.duration=0.2'])
+    recorder = ListRecorder()
+    c = controller(scenario, recorder=recorder, loop=False, publish_rate_hz=0.0)
+    assert [t.name for t in topic_table(c.layout)] == [
+        '/clock', 'piles/pier01/pile01/displacement', 'piles/pier01/pile01/imu', 'soil/points']
+    c.apply('train.speed_kmh', 350)   # accepted, no effect on the substructure
+    published = run_until_idle(c)
+    assert c.state == 'idle' and len(recorder.frames) == 21 == len(published)
+    assert recorder.frames[-1].time == pytest.approx(0.2)
+    assert abs(recorder.frames[-1].pile_displacement[0, 2]) > 0
+    assert recorder.frames[-1].soil_points.shape[1] == 9

@@ -15,11 +15,21 @@
 """
 Post-processing of frames and bag arrays (never imports the model).
 
-``psd``: Welch PSD with windows long enough for the lowest frequency of interest,
-zero-padded periodograms, peak and level-change frequencies.
+- ``psd``: Welch PSD with windows long enough for the lowest frequency of
+  interest, zero-padded periodograms, peak and level-change frequencies;
+- ``power_flow``: frequency-domain power flow of a force against a velocity
+  ([P] Eqs. 17-18), Parseval-consistent;
+- ``weighting``: ISO 2631 weightings Wk, Wd, Wm and weighted r.m.s.;
+- ``levels``: 1/3-octave vibration acceleration levels (a0 = 1e-6 m/s^2);
+- ``ride``: Sperling index, car-body acceleration limits;
+- ``safety``: Q/P, wheel-load reduction, lateral wheelset force, deck acceleration;
+- ``excitation``: excitation frequencies to mark ([P] Eqs. 15, 19, passing);
+- ``rigid_displacement``: the rigid-displacement method ([P] Eq. 16);
+- ``figures``: PNG figures (matplotlib, Agg) of these on arrays.
 """
 
 from ttb_sim.analysis.psd import (level_change_frequency, padded_periodogram, peak_frequency,
-                                  welch_psd)
+                                  resolving_segment_seconds, welch_psd)
 
-__all__ = ['level_change_frequency', 'padded_periodogram', 'peak_frequency', 'welch_psd']
+__all__ = ['level_change_frequency', 'padded_periodogram', 'peak_frequency',
+           'resolving_segment_seconds', 'welch_psd']

@@ -445,3 +445,25 @@ def level_change_frequency(f: ArrayLike, p: ArrayLike,
                      direction, band, step[j], found)
     _LOG.debug('Level change %.3g decades at %.6g Hz (window %d bins)', step[j], found, width)
     return float(found)
+
+
+def resolving_segment_seconds(lowest_hz: float, record_seconds: float,
+                              bins_below: float = 6.0) -> float:
+    """
+    Return the Welch segment length (s) that resolves ``lowest_hz`` with ``bins_below`` bins.
+
+    The bin spacing ``1 / T`` must be ``lowest_hz / bins_below`` or finer:
+    0.84 Hz (the car-body mode) needs 7.1 s segments, where [P]'s 20 m window
+    at 300 km/h (0.24 s, 4.2 Hz bins) cannot see it (PHYSICS.md section 8).  A
+    record shorter than that is taken whole (one Hann segment) and its coarser
+    resolution is logged.
+    """
+    lowest = _positive('lowest_hz', lowest_hz)
+    record = _positive('record_seconds', record_seconds)
+    wanted = _positive('bins_below', bins_below) / lowest
+    if wanted > record:
+        _LOG.info('record of %.3g s is shorter than the %.3g s segment that resolves %.3g Hz '
+                  'with %g bins: one segment, bins of %.3g Hz', record, wanted, lowest,
+                  bins_below, 1.0 / record)
+        return record
+    return wanted

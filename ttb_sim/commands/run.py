@@ -34,12 +34,11 @@ from typing import Any, Callable, NoReturn, Sequence
 
 from ttb_sim import __version__
 from ttb_sim.config import load_scenario, Scenario
-from ttb_sim.errors import DivergenceError
+from ttb_sim.errors import SimulationError
 from ttb_sim.io.bag import BagRecorder, check_destination, default_bag_path, make_parents
 from ttb_sim.io.topics import PeakTracker, topic_table
-from ttb_sim.model.vehicle.train import MultibodyCars
-from ttb_sim.sim.cost import CostEstimate, estimate_cost, STEP_BUDGET
-from ttb_sim.sim.simulation import Simulation
+from ttb_sim.sim.cost import CostEstimate, STEP_BUDGET
+from ttb_sim.sim.runner import make_runner, Runner
 
 log = logging.getLogger(__name__)
 
@@ -97,7 +96,7 @@ class RunResult:
 
 def run_to_bag(scenario: Scenario, out: Path, storage: str = 'mcap',
                progress: Callable[[int], None] | None = None,
-               simulation: Simulation | None = None,
+               simulation: Runner | None = None,
                should_stop: Callable[[], bool] | None = None,
                setup_time: float = 0.0, estimate: CostEstimate | None = None) -> RunResult:
     """
@@ -113,8 +112,8 @@ def run_to_bag(scenario: Scenario, out: Path, storage: str = 'mcap',
         'mcap' or 'sqlite3'.
     progress : callable, optional
         Called with the number of frames written since the last call.
-    simulation : Simulation, optional
-        An already built simulation of ``scenario``.
+    simulation : Runner, optional
+        An already built model of ``scenario`` (:func:`~ttb_sim.sim.runner.make_runner`).
     should_stop : callable, optional
         Polled between frames; when it returns True the run stops cleanly with
         status 'interrupted' (signal handlers set such a flag, so that no
@@ -142,10 +141,10 @@ def run_to_bag(scenario: Scenario, out: Path, storage: str = 'mcap',
     out = Path(out)
     check_destination(out, storage)  # before summary.json could land in someone's folder
     built = time.perf_counter()
-    sim = simulation or Simulation(scenario)
+    sim = simulation or make_runner(scenario)
     setup_time += time.perf_counter() - built
     topics = topic_table(sim.layout)
-    estimate = estimate or plan_cost(sim, len(topics))
+    estimate = estimate or sim.plan(len(topics))
     peaks = PeakTracker(topics)
     make_parents(out)
     status, message, frames, last_time = 'ok', '', 0, 0.0
@@ -162,7 +161,7 @@ def run_to_bag(scenario: Scenario, out: Path, storage: str = 'mcap',
                 if should_stop is not None and should_stop():
                     status, message = 'interrupted', 'stopped by a signal'
                     break
-    except DivergenceError as exc:
+    except SimulationError as exc:  # divergence, interface iterations that fail
         status, message = 'diverged', str(exc)
     except KeyboardInterrupt:
         status, message = 'interrupted', 'interrupted by a signal'
@@ -174,12 +173,12 @@ def run_to_bag(scenario: Scenario, out: Path, storage: str = 'mcap',
             'ttb_sim_version': __version__,
             'status': status,
             'message': message,
-            'scenario': scenario.to_dict(),
+            'scenario': scenario.echo(),
             'bag': {'path': str(out), 'storage': storage,
                     'topics': [t.full_name() for t in topics]},
             'solver': {'dt': sim.dt, 'steps_planned': sim.n_steps,
-                       'duration_planned': sim.duration, 'free_dofs': sim.structure.n_free,
-                       'output_every_steps': sim.output_every},
+                       'duration_planned': sim.duration, 'free_dofs': sim.n_free,
+                       'output_every_steps': sim.output_every, **sim.describe()},
             'frames': frames,
             'simulated_time': last_time,
             'estimate': estimate.as_dict(),
@@ -193,14 +192,6 @@ def run_to_bag(scenario: Scenario, out: Path, storage: str = 'mcap',
             (out / 'summary.json').write_text(json.dumps(summary, indent=2) + '\n',
                                               encoding='utf-8')
     return RunResult(path=out, status=status, summary=summary)
-
-
-def plan_cost(sim: Simulation, messages_per_frame: int) -> CostEstimate:
-    """Return the cost estimate of a built simulation (before it runs)."""
-    cars = sim.vehicle.n_cars if isinstance(sim.vehicle, MultibodyCars) else 0
-    return estimate_cost(steps=sim.n_steps, dt=sim.dt, free_dofs=sim.structure.n_free,
-                         cars=cars, frames=sim.n_frames, messages_per_frame=messages_per_frame,
-                         variant=sim.scenario.solver.variant)
 
 
 def run(scenario: str | Path, *, out: Path | None = None, storage: str = 'mcap',
@@ -238,7 +229,7 @@ def run(scenario: str | Path, *, out: Path | None = None, storage: str = 'mcap',
     try:
         loaded, out, simulation = _set_up(scenario, out, storage, overrides, speed_kmh,
                                           duration, force)
-        estimate = plan_cost(simulation, len(topic_table(simulation.layout)))
+        estimate = simulation.plan(len(topic_table(simulation.layout)))
         print(f'ttb-sim: plan: {estimate.describe()}', file=sys.stderr)
         stop.setup = False  # from here on a signal closes the bag cleanly
         if sys.stderr.isatty():
@@ -271,7 +262,7 @@ def run(scenario: str | Path, *, out: Path | None = None, storage: str = 'mcap',
 
 def _set_up(scenario: str | Path, out: Path | None, storage: str, overrides: Sequence[str],
             speed_kmh: float | None, duration: float | None, force: bool
-            ) -> tuple[Scenario, Path, Simulation]:
+            ) -> tuple[Scenario, Path, Runner]:
     """Load the scenario, check the destination, then build the model (in that order)."""
     values: list[tuple[str, Any]] = []
     if speed_kmh is not None:
@@ -282,4 +273,4 @@ def _set_up(scenario: str | Path, out: Path | None, storage: str, overrides: Seq
     out = Path(out) if out is not None else default_bag_path(loaded.name)
     check_destination(out, storage)  # before the model is built: a bad --out fails at once
     log.info('set-up: building the model of %s', loaded.name)
-    return loaded, out, Simulation(loaded, max_steps=None if force else STEP_BUDGET)
+    return loaded, out, make_runner(loaded, max_steps=None if force else STEP_BUDGET)

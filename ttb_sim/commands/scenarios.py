@@ -16,8 +16,8 @@
 
 from __future__ import annotations
 
-from ttb_sim.config import builtin_scenarios, iter_keys, read_yaml
-from ttb_sim.config.schema import ALIASES
+from ttb_sim.config import builtin_scenarios, iter_keys, read_yaml, to_plain
+from ttb_sim.config.schema import ALIASES, record_item
 
 EXIT_OK = 0
 
@@ -25,10 +25,19 @@ EXIT_OK = 0
 def scenarios(*, keys: bool = False) -> int:
     """Run ``ttb-sim scenarios``: the built-ins, or with ``keys`` every key and its range."""
     if keys:
-        for key, _typ, default, spec in iter_keys():
+        for key, typ, default, spec in iter_keys():
+            item = record_item(typ)
+            if item is not None:
+                print(f'{key:34s} {"list":9s} default {len(default)} entries\n'
+                      f'{"":34s} {spec.description}')
+                for sub_key, _t, sub_default, sub_spec in iter_keys(item, prefix=f'{key}[].'):
+                    print(f'{sub_key:34s} {sub_spec.unit:9s} default {sub_default!r:14} '
+                          f'{sub_spec.allowed()}\n{"":34s} {sub_spec.description}')
+                continue
             dyn = ' (dynamic)' if spec.dynamic else ''
-            print(f'{key:34s} {spec.unit:9s} default {default!r:14} {spec.allowed()}{dyn}\n'
-                  f'{"":34s} {spec.description}')
+            shown_default = to_plain(default)
+            print(f'{key:34s} {spec.unit:9s} default {shown_default!r:14} {spec.allowed()}'
+                  f'{dyn}\n{"":34s} {spec.description}')
         for old, new in ALIASES.items():
             print(f'{old:34s} alias of {new}')
         return EXIT_OK

@@ -19,8 +19,9 @@ A scenario is a tree of these records (:class:`Scenario` at the root).  Every
 leaf is declared with :func:`~ttb_sim.parameters.param` (default, unit, range
 or choices, description). The sections the model consumes are the model's own
 records: car (:class:`~ttb_sim.model.vehicle.car.CarParameters`), track, bridge,
-bearings, piers, foundation (``model/track.py``, ``model/bridge.py``) and contact
-(``model/wheel_rail/parameters.py``); the rest (train, irregularity, solver,
+bearings, piers, foundation (``model/track.py``, ``model/bridge.py``), contact
+(``model/wheel_rail/parameters.py``) and the pile-soil sections soil, piles, cap,
+interface and load (``model/foundation/records.py``); the rest (train, irregularity, solver,
 output) are declared here.  Rules that involve more
 than one key are checked when a :class:`Scenario` is made.
 """
@@ -39,6 +40,9 @@ from ttb_sim.errors import ScenarioError
 from ttb_sim.inputs import shown
 from ttb_sim.model.bridge import (BearingParameters, BridgeParameters, FoundationParameters,
                                   PierParameters, span_frequency)
+from ttb_sim.model.foundation.records import (Cap, check_substructure, Interface, Observation,
+                                              PileGroup, PileLoad, SoilParameters, Substructure)
+from ttb_sim.model.foundation.substructure import planned_nodes
 from ttb_sim.model.track import track_extent, TrackExtent, TrackParameters
 from ttb_sim.model.vehicle.car import CarParameters
 from ttb_sim.model.wheel_rail.parameters import ContactParameters
@@ -131,8 +135,10 @@ class SolverConfig:
                          'symmetric effective matrices with a fill-reducing order and take the '
                          "lean step: 'qdldl' (LDL^T, the fastest measured), 'cholmod' "
                          "(CHOLMOD Cholesky via cholespy), 'superlu_sym' (pure scipy). They "
-                         "agree with 'reference' to round-off (README, Benchmark).",
-                         choices=('qdldl', 'cholmod', 'superlu_sym', 'reference'))
+                         "agree with 'reference' to round-off (README, Benchmark). 'reduced' "
+                         '(opt-in) is qdldl with the slab track detailed only in a window '
+                         'around the train, the far track condensed onto the bridge.',
+                         choices=('qdldl', 'cholmod', 'superlu_sym', 'reference', 'reduced'))
 
 
 @dataclass(frozen=True)
@@ -146,6 +152,10 @@ class OutputConfig:
                                        "'name=component@x' with component rail_left, "
                                        'rail_right, slab, base or girder and x the position '
                                        'along the track (m); published on ~/observers/name.')
+    soil_points: tuple[tuple[float, ...], ...] = param(
+        (), 'm', 'Ground observation points [x, y, z] of a pile-soil substructure, besides '
+        "[P]'s observation line and VAL points (published on ~/soil/points).", low=-1e4,
+        high=1e4)
 
     @functools.cached_property
     def points(self) -> tuple[Observer, ...]:
@@ -168,12 +178,28 @@ class Scenario:
     piers: PierParameters = field(default_factory=PierParameters)
     foundation: FoundationParameters = field(default_factory=FoundationParameters)
     irregularity: IrregularityConfig = field(default_factory=IrregularityConfig)
+    soil: SoilParameters = field(default_factory=SoilParameters)
+    piles: PileGroup = field(default_factory=PileGroup)
+    cap: Cap = field(default_factory=Cap)
+    interface: Interface = field(default_factory=Interface)
+    load: PileLoad = field(default_factory=PileLoad)
     solver: SolverConfig = field(default_factory=SolverConfig)
     output: OutputConfig = field(default_factory=OutputConfig)
 
     def __post_init__(self) -> None:
         """Check the rules that involve more than one key."""
         _check_consistency(self)
+
+    @property
+    def substructure_only(self) -> bool:
+        """True when the scenario is the pile-soil substructure alone under ``load``."""
+        return self.load.type != 'none'
+
+    def substructure(self, name: str = 'pier01') -> Substructure:
+        """Return the pile-soil substructure the soil, piles, cap and interface keys describe."""
+        return Substructure(name=name, soil=self.soil, piles=self.piles, cap=self.cap,
+                            interface=self.interface,
+                            observation=Observation(points=self.output.soil_points))
 
     def axle_positions(self) -> tuple[float, ...]:
         """Distances of all axles behind the head (m): ``train.axle_offsets`` or the car layout."""
@@ -182,8 +208,20 @@ class Scenario:
         return car_layout(self.train, self.car)
 
     def to_dict(self) -> dict[str, Any]:
-        """Return the scenario as plain nested dicts (for echo in summaries)."""
+        """Return the scenario as plain nested dicts."""
         return to_plain(dataclasses.asdict(self))
+
+    def echo(self) -> dict[str, Any]:
+        """Return the sections the run uses as plain nested dicts (for ``summary.json``)."""
+        unused = TRAIN_SECTIONS if self.substructure_only else SUBSTRUCTURE_SECTIONS
+        return {k: v for k, v in self.to_dict().items() if k not in unused}
+
+
+TRAIN_SECTIONS = ('train', 'car', 'track', 'contact', 'bridge', 'bearings', 'piers',
+                  'foundation', 'irregularity')
+"""Sections a substructure-only run (``load.type`` set) ignores."""
+SUBSTRUCTURE_SECTIONS = ('soil', 'piles', 'cap', 'interface', 'load')
+"""Sections of the pile-soil substructure, unused by a train run on foundation springs."""
 
 
 def car_layout(train: TrainConfig, car: CarParameters) -> tuple[float, ...]:
@@ -196,6 +234,9 @@ def car_layout(train: TrainConfig, car: CarParameters) -> tuple[float, ...]:
 
 
 def _check_consistency(s: Scenario) -> None:
+    if s.substructure_only:
+        _check_substructure(s)
+        return
     if s.bridge.elements_per_span % 2:
         raise ScenarioError(f'bridge.elements_per_span = {s.bridge.elements_per_span}: must be '
                             'even, so that a node sits at mid-span')
@@ -211,6 +252,25 @@ def _check_consistency(s: Scenario) -> None:
     _check_model_size(s)
     _check_track_fit(s)
     _check_observers(s)
+
+
+MAX_SOIL_NODES = 600_000
+"""Most brick-mesh nodes a pile-soil substructure may have (1.8 million DOFs, about 8 GiB;
+pile_harmonic: 250 000)."""
+
+
+def _check_substructure(s: Scenario) -> None:
+    """Refuse a substructure that does not fit together or is too large, before building it."""
+    spec = s.substructure()
+    check_substructure(spec, s.load)
+    nodes = planned_nodes(spec)
+    if nodes > MAX_SOIL_NODES:
+        m = spec.mesh
+        raise ScenarioError(
+            f'the soil mesh would have {nodes} nodes (about {3 * nodes:.3g} DOFs), over the '
+            f'limit of {MAX_SOIL_NODES}: raise soil.mesh.h = {m.h:g} m, soil.mesh.h_max = '
+            f'{m.h_max:g} m or soil.mesh.growth = {m.growth:g}, or reduce soil.block.lx = '
+            f'{s.soil.block.lx:g} m, soil.block.ly = {s.soil.block.ly:g} m')
 
 
 MAX_MODEL_NODES = 200_000

@@ -199,6 +199,18 @@ def _coerce(path: str, value: Any, typ: Any, spec: Spec) -> Any:
         items = tuple(_coerce_number(f'{path}[{i}]', v, float, spec)
                       for i, v in enumerate(value))
         return items
+    if typ in (tuple[tuple[float, ...], ...],):
+        if not isinstance(value, (list, tuple)):
+            raise ScenarioError(f'{path} = {shown(value)}: expected a list of [x, y, z] points '
+                                f'({spec.unit})')
+        points = []
+        for i, point in enumerate(value):
+            if not isinstance(point, (list, tuple)) or len(point) != 3:
+                raise ScenarioError(f'{path}[{i}] = {shown(point)}: expected a point [x, y, z] '
+                                    f'of three numbers ({spec.unit})')
+            points.append(tuple(_coerce_number(f'{path}[{i}][{j}]', v, float, spec)
+                                for j, v in enumerate(point)))
+        return tuple(points)
     if typ in (tuple[str, ...],):
         if not isinstance(value, (list, tuple)) or not all(isinstance(v, str) for v in value):
             raise ScenarioError(f'{path} = {shown(value)}: expected a list of strings')
@@ -225,6 +237,11 @@ def _record_item(typ: Any) -> type | None:
             and dataclasses.is_dataclass(args[0]) and isinstance(args[0], type)):
         return args[0]
     return None
+
+
+def record_item(typ: Any) -> type | None:
+    """Return the record type X of a list-of-records key (``tuple[X, ...]``), else None."""
+    return _record_item(typ)
 
 
 def _field_names(record: type) -> str:

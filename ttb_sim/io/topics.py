@@ -237,13 +237,12 @@ def topic_table(layout: Layout) -> list[Topic]:
     list of Topic
 
     """
-    topics = [
-        Topic('/clock', 'rosgraph_msgs/msg/Clock', (), _no_values, build_clock,
-              qos='clock', unit='s'),
-        Topic('train/odometry', 'nav_msgs/msg/Odometry',
-              ('pose.pose.position.x', 'twist.twist.linear.x'),
-              _odometry_values, build_odometry, unit='m, m/s'),
-    ]
+    topics = [Topic('/clock', 'rosgraph_msgs/msg/Clock', (), _no_values, build_clock,
+                    qos='clock', unit='s')]
+    if layout.train:
+        topics.append(Topic('train/odometry', 'nav_msgs/msg/Odometry',
+                            ('pose.pose.position.x', 'twist.twist.linear.x'),
+                            _odometry_values, build_odometry, unit='m, m/s'))
     for i in range(layout.n_bodies):
         topics.append(Topic(
             f'train/car{i + 1:02d}/body/imu', 'sensor_msgs/msg/Imu', IMU,

@@ -16,7 +16,8 @@
 """
 The RViz / Foxglove markers of ``~/model/markers``, described as plain data.
 
-:func:`model_markers` gives one :class:`Box` per girder, pier and abutment,
+:func:`model_markers` gives one :class:`Box` per girder, pier and abutment (or,
+for a pile-soil substructure run, per pile plus the soil block and the cap),
 :func:`train_markers` the car bodies and axles at a head position, and
 :func:`markers` the complete :class:`MarkerSet` that the node sends latched.
 """
@@ -37,7 +38,8 @@ class Box:
     Attributes
     ----------
     ns : str
-        Marker namespace ('girders', 'piers', 'abutments', 'train', 'axles').
+        Marker namespace ('girders', 'piers', 'abutments', 'train', 'axles', 'piles',
+        'cap', 'soil').
     marker_id : int
         Id, unique within the namespace.
     position : tuple of float
@@ -69,6 +71,9 @@ PIER_COLOR = (0.45, 0.45, 0.50, 1.0)
 ABUTMENT_COLOR = (0.35, 0.35, 0.38, 1.0)
 CAR_COLOR = (0.85, 0.85, 0.95, 0.9)
 AXLE_COLOR = (0.9, 0.2, 0.15, 1.0)
+PILE_COLOR = (0.55, 0.55, 0.60, 1.0)
+CAP_COLOR = (0.50, 0.50, 0.55, 1.0)
+SOIL_COLOR = (0.55, 0.42, 0.28, 0.25)
 
 
 def _girder_depth(scenario: Scenario) -> float:
@@ -93,6 +98,8 @@ def model_markers(scenario: Scenario) -> list[Box]:
     list of Box
 
     """
+    if scenario.substructure_only:
+        return pile_group_markers(scenario)
     b = scenario.bridge
     depth = _girder_depth(scenario)
     width = scenario.bearings.spacing + 2.0
@@ -112,6 +119,26 @@ def model_markers(scenario: Scenario) -> list[Box]:
     return boxes
 
 
+def pile_group_markers(scenario: Scenario) -> list[Box]:
+    """
+    Describe a pile-soil substructure: one box per pile, the cap if modelled, the soil block.
+
+    Positions are in the substructure's own axes (ground surface z = 0, block
+    centred on the origin); circular piles are drawn as their equal-area squares.
+    """
+    piles, soil, cap = scenario.piles, scenario.soil, scenario.cap
+    w = piles.width
+    boxes = [Box('piles', i, (x, y, -piles.length / 2), (w, w, piles.length), PILE_COLOR)
+             for i, (x, y) in enumerate(piles.centres())]
+    if cap.enabled:
+        cx, cy = piles.centre
+        boxes.append(Box('cap', 0, (cx, cy, cap.thickness / 2), (cap.lx, cap.ly, cap.thickness),
+                         CAP_COLOR))
+    boxes.append(Box('soil', 0, (0.0, 0.0, -soil.depth / 2),
+                     (soil.block.lx, soil.block.ly, soil.depth), SOIL_COLOR))
+    return boxes
+
+
 def train_markers(scenario: Scenario, head_position: float) -> list[Box]:
     """
     Describe the train at a head position: car bodies and one small box per axle.
@@ -128,6 +155,8 @@ def train_markers(scenario: Scenario, head_position: float) -> list[Box]:
     list of Box
 
     """
+    if scenario.substructure_only:
+        return []
     t = scenario.train
     offsets = scenario.axle_positions()
     boxes = [Box('axles', i, (head_position - a, 0.0, 0.5), (1.0, 1.5, 1.0), AXLE_COLOR)

@@ -16,7 +16,8 @@
 """
 Passage control: the simulation stepping behind the live node, paced and recorded.
 
-:class:`PassageController` owns a :class:`~ttb_sim.sim.simulation.Simulation`,
+:class:`PassageController` owns a :class:`~ttb_sim.sim.runner.Runner` (a train
+simulation, or a pile-soil substructure alone under its load),
 steps it paced by the real-time factor, hands every frame to a recorder (a
 :class:`FrameSink`) and the frames due for live publishing (``publish_rate_hz``
 of simulation time) to the caller as a :class:`Tick`, and handles speed
@@ -40,6 +41,7 @@ from ttb_sim.errors import DivergenceError, TtbSimError
 from ttb_sim.node.parameters import (IRREGULARITY_KEYS, normalize_value, parameter_table,
                                      SCENARIO_KEYS, scenario_with)
 from ttb_sim.sim.frames import Frame, Layout
+from ttb_sim.sim.runner import make_runner, Runner
 from ttb_sim.sim.simulation import Simulation
 
 log = logging.getLogger(__name__)
@@ -155,7 +157,7 @@ class PassageController:
         self.passage = 0
         self.time_offset = 0.0
         self.last_frame: Frame | None = None
-        self.sim: Simulation
+        self.sim: Runner
         self._frames: Iterator[Frame]
         self._anchor: tuple[float, float] | None = None
         self._exit_time: float | None = None
@@ -187,7 +189,10 @@ class PassageController:
                 value = normalize_value(param, value)
             self.values[name] = value
             if name == 'train.speed_kmh':
-                self.sim.set_speed(value / 3.6)
+                if isinstance(self.sim, Simulation):
+                    self.sim.set_speed(value / 3.6)
+                else:
+                    log.info('train.speed_kmh has no effect on a substructure run')
             elif name == 'real_time_factor':   # the new pace counts from now
                 self._anchor = (self._clock(), self._node_time)
             elif name == 'publish_rate_hz':
@@ -341,7 +346,7 @@ class PassageController:
         position and the free-vibration tail (free_vibration_periods / f1) has
         elapsed since: so a speed change shortens or lengthens the passage.
         """
-        if self.base.solver.duration > 0:
+        if self.base.solver.duration > 0 or not isinstance(self.sim, Simulation):
             return False
         if raw.head_position < self.sim.exit_position:
             return False
@@ -375,7 +380,7 @@ class PassageController:
     def _start_passage(self) -> None:
         """Build a new simulation from the current parameters and start stepping it."""
         scenario = self.passage_scenario()
-        self.sim = Simulation(scenario)
+        self.sim = make_runner(scenario)
         self._frames = self.sim.frames()
         self._exit_time = None
         self.passage += 1

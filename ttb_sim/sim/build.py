@@ -37,6 +37,7 @@ from ttb_sim.sim.coupling.moving_force import MovingForceCoupling
 from ttb_sim.sim.coupling.quarter_car import QuarterCarTrain
 from ttb_sim.sim.coupling.train_track import TrainTrackCoupling
 from ttb_sim.sim.integrators.protocol import Integrator
+from ttb_sim.sim.reduced_track import ReducedTrainTrackCoupling
 
 __all__ = ['build_coupling', 'build_irregularity', 'build_structure', 'build_vehicle',
            'CONTACT_STEP', 'observer_rows', 'StepLimits', 'vehicle_track_setup',
@@ -117,7 +118,7 @@ def vehicle_track_setup(scenario: Scenario, structure: Structure,
 
 def build_coupling(scenario: Scenario, structure: Structure, vehicle: Vehicle,
                    integrator: Integrator, irregularity: TrackIrregularity | None, *,
-                   lean: bool = False) -> Coupling:
+                   lean: bool = False, reduced: bool = False) -> Coupling:
     """
     Couple the scenario's vehicle model to the structure (the one place that dispatches on it).
 
@@ -131,11 +132,15 @@ def build_coupling(scenario: Scenario, structure: Structure, vehicle: Vehicle,
         The realised track irregularity.
     lean : bool
         Lean load kernels (solver variants other than ``reference``).
+    reduced : bool
+        Multibody cars on the reduced track-bridge, detailed only around the
+        train (:mod:`ttb_sim.sim.reduced_track`); the other vehicles ignore it.
 
     """
     if isinstance(vehicle, MultibodyCars):
-        return TrainTrackCoupling(scenario.car, scenario.contact, vehicle.n_cars,
-                                  vehicle.car_length, structure, integrator, irregularity)
+        coupling = ReducedTrainTrackCoupling if reduced else TrainTrackCoupling
+        return coupling(scenario.car, scenario.contact, vehicle.n_cars,
+                        vehicle.car_length, structure, integrator, irregularity)
     if isinstance(vehicle, QuarterCars):
         return QuarterCarTrain(vehicle, structure, integrator, irregularity)
     return MovingForceCoupling(vehicle, structure, integrator, lean=lean)

@@ -49,8 +49,10 @@ CONTACT_PER_CAR_MS = 0.9
 """Per-step cost of wheel-rail contact per multibody car (ms)."""
 MESSAGE_MS = 0.08
 """Cost of writing one message to the bag (ms)."""
-VARIANT_FACTOR = {'qdldl': 1.0, 'cholmod': 1.0, 'superlu_sym': 1.8, 'reference': 3.5}
-"""Per-step cost of each solver variant relative to qdldl (README, Benchmark)."""
+VARIANT_FACTOR = {'qdldl': 1.0, 'cholmod': 1.0, 'superlu_sym': 1.8, 'reference': 3.5,
+                  'reduced': 0.6}
+"""Per-step cost of the structure's solves and mat-vecs for each solver variant relative to
+qdldl (README, Benchmark); ``reduced`` only with multibody cars (else it is qdldl)."""
 
 
 @dataclass(frozen=True)
@@ -116,7 +118,8 @@ def estimate_cost(*, steps: int, dt: float, free_dofs: int, cars: int, frames: i
 
     """
     per_step = STEP_BASE_MS + STEP_PER_DOF_MS * free_dofs
-    per_step *= VARIANT_FACTOR.get(variant, 1.0)
+    if cars or variant != 'reduced':
+        per_step *= VARIANT_FACTOR.get(variant, 1.0)
     if cars:
         per_step += CONTACT_BASE_MS + CONTACT_PER_CAR_MS * (cars - 1)
     messages = frames * messages_per_frame

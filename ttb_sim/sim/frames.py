@@ -37,6 +37,8 @@ class Layout:
     """(pier number, 1-based; number of piles) of every piled pier, in frame order."""
     soil_points: int = 0
     """Number of ground observation points (all piled piers together)."""
+    train: bool = True
+    """Whether a train runs (False for a substructure alone: no odometry)."""
 
     @property
     def n_piles(self) -> int:

@@ -484,7 +484,7 @@ def states(model: PileSoilModel, force: np.ndarray, history: Callable[[float], f
 
 def default_output_dt(load: PileLoad) -> float:
     """Return 1/20 of the load period (s), or 5 ms for a static load."""
-    if load.kind == 'static':
+    if load.type == 'static':
         return 0.005
     return 1.0 / (20.0 * load.frequency)
 
@@ -498,7 +498,7 @@ def run(model: PileSoilModel, load: PileLoad, duration: float,
     harmonic or pulse load starts from rest at t = 0.
     """
     force = model.load_vector(load)
-    if load.kind == 'static':
+    if load.type == 'static':
         yield observe(model, static_solve(model, force))
         return
     dt = default_output_dt(load) if output_dt is None else output_dt

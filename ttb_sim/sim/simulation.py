@@ -23,16 +23,17 @@ from __future__ import annotations
 
 import logging
 import math
-from typing import Iterator
+from typing import Any, Iterator
 
 import numpy as np
 
 from ttb_sim.config import Scenario
 from ttb_sim.errors import DivergenceError, ModelError, ScenarioError
 from ttb_sim.model.bridge import bearing_forces
+from ttb_sim.model.vehicle.train import MultibodyCars
 from ttb_sim.sim.build import (build_coupling, build_structure, build_vehicle, observer_rows,
                                vehicle_track_setup)
-from ttb_sim.sim.cost import STEP_BUDGET
+from ttb_sim.sim.cost import CostEstimate, estimate_cost, STEP_BUDGET
 from ttb_sim.sim.frames import Frame, Layout
 from ttb_sim.sim.integrators.newmark import Newmark
 from ttb_sim.sim.variants import blas_threads, solver_variant
@@ -133,7 +134,8 @@ class Simulation:
                                       method=self.variant.factorization,
                                       lean=self.variant.lean)
             self.coupling = build_coupling(scenario, st, self.vehicle, self.integrator,
-                                           self.irregularity, lean=self.variant.lean)
+                                           self.irregularity, lean=self.variant.lean,
+                                           reduced=self.variant.reduced)
         self.layout = Layout(n_spans=scenario.bridge.n_spans, n_supports=st.n_supports,
                              n_bodies=self.coupling.n_bodies, n_axles=self.coupling.n_axles,
                              observers=names)
@@ -193,6 +195,23 @@ class Simulation:
     def n_frames(self) -> int:
         """Number of frames :meth:`frames` yields."""
         return self.n_steps // self.output_every + 1
+
+    @property
+    def n_free(self) -> int:
+        """Free DOFs of the structure."""
+        return self.structure.n_free
+
+    def plan(self, messages_per_frame: int) -> CostEstimate:
+        """Return the cost estimate of the run (before it runs)."""
+        return estimate_cost(steps=self.n_steps, dt=self.dt, free_dofs=self.n_free,
+                             cars=self.vehicle.n_cars if isinstance(self.vehicle, MultibodyCars)
+                             else 0,
+                             frames=self.n_frames, messages_per_frame=messages_per_frame,
+                             variant=self.scenario.solver.variant)
+
+    def describe(self) -> dict[str, Any]:
+        """Return stepping details for ``summary.json`` (the solver section has the rest)."""
+        return {'variant': self.scenario.solver.variant}
 
     def auto_duration(self) -> float:
         """Return the time for the last axle to leave the bridge plus free vibration (s)."""

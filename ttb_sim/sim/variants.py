@@ -20,6 +20,9 @@ constant matrices (:mod:`ttb_sim.fe.factorization`), whether the lean step is
 taken, and how many BLAS threads the run may use. ``reference`` is the
 validated path as it was written, with the process's BLAS threads untouched, so
 its bags stay bit-identical to those of earlier versions on the same machine.
+``reduced`` is the one variant that changes the model, not only how it is
+solved: the track away from the train rides on the girder (an approximation
+with a stated range, README Benchmark); it is opt-in.
 The other variants run the BLAS single-threaded: the small dense solves of the
 contact iteration (32 x 32 per car) only spin a second thread (measured 9x
 slower with two threads on two cores), and one thread makes the results
@@ -47,6 +50,9 @@ class SolverVariant:
     """True for the lean step (fused mat-vecs, preallocated work vectors)."""
     blas_threads: int | None
     """BLAS threads while building and stepping; None leaves the process setting."""
+    reduced: bool = False
+    """True to solve the slab track in detail only in a window around the train
+    (:mod:`ttb_sim.sim.reduced_track`); models without a slab track run as without."""
 
 
 VARIANTS = {
@@ -54,6 +60,7 @@ VARIANTS = {
     'cholmod': SolverVariant('cholmod', 'cholmod', lean=True, blas_threads=1),
     'qdldl': SolverVariant('qdldl', 'qdldl', lean=True, blas_threads=1),
     'superlu_sym': SolverVariant('superlu_sym', 'superlu_sym', lean=True, blas_threads=1),
+    'reduced': SolverVariant('reduced', 'qdldl', lean=True, blas_threads=1, reduced=True),
 }
 """Every variant by name (the choices of ``solver.variant``)."""
 

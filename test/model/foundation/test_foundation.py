@@ -25,9 +25,9 @@ import numpy as np
 import pytest
 
 from ttb_sim.model.foundation.desai import DesaiLaw, initial_moduli
-from ttb_sim.model.foundation.records import (check_substructure, FoundationError, MeshSize,
-                                              Observation, PAPER_LAYERS, PileGroup, PileLoad,
-                                              SoilBlock, SoilLayer, Substructure)
+from ttb_sim.model.foundation.records import (BlockSize, check_substructure, FoundationError,
+                                              MeshSize, Observation, PAPER_LAYERS, PileGroup,
+                                              PileLoad, SoilLayer, SoilParameters, Substructure)
 from ttb_sim.model.foundation.substructure import build
 from ttb_sim.validation.cases.pile_soil import desai_monotonic
 
@@ -40,7 +40,8 @@ BAD_DIRECTION: Any = 'w'
     (lambda: PileGroup(spacing=0.8), r'piles\.spacing = 0\.8 .*overlap'),
     (lambda: PileGroup(nu=0.5), r'piles\.nu = 0\.5'),
     (lambda: MeshSize(h=1.0, h_max=0.5), r'soil\.mesh\.h_max = 0\.5'),
-    (lambda: PileLoad(direction=BAD_DIRECTION), r"load\.direction = 'w' is not one of x, y, z"),
+    (lambda: PileLoad(direction=BAD_DIRECTION),
+     r"load\.direction = 'w' is invalid; allowed: one of 'x', 'y', 'z'"),
 ])
 def test_bad_records_are_refused(make, match):
     with pytest.raises(FoundationError, match=match):
@@ -50,14 +51,15 @@ def test_bad_records_are_refused(make, match):
 def test_bad_combinations_are_refused():
     """Piles outside the block, too long, a missing pile, a mesh too coarse for the load."""
     with pytest.raises(FoundationError, match=r'outside the soil block'):
-        check_substructure(Substructure(soil=SoilBlock(lx=10.0, ly=30.0)))
+        check_substructure(Substructure(soil=SoilParameters(block=BlockSize(10.0, 30.0))))
     with pytest.raises(FoundationError, match=r'piles\.length = 25\.0 .*< 22 m'):
         check_substructure(Substructure(piles=PileGroup(length=25.0)))
     with pytest.raises(FoundationError, match=r'load\.pile = 16'):
-        check_substructure(Substructure(), PileLoad(pile=16))
+        check_substructure(Substructure(), PileLoad('harmonic', pile=16))
     with pytest.raises(FoundationError,
                        match=r'load\.frequency = 20 Hz .*soil\.mesh\.h <= 0\.178'):
-        check_substructure(Substructure(mesh=MeshSize(h=0.5)), PileLoad(frequency=20.0))
+        check_substructure(Substructure(soil=SoilParameters(mesh=MeshSize(h=0.5))),
+                           PileLoad('harmonic', frequency=20.0))
 
 
 def test_desai_monotonic_shear_v16():
@@ -87,9 +89,9 @@ def test_desai_normal_tangent_and_separation():
 
 
 def _small_group():
-    return Substructure(soil=SoilBlock(PAPER_LAYERS, lx=14.0, ly=11.0),
+    mesh = MeshSize(h=0.8, growth=1.5, h_max=3.0)
+    return Substructure(soil=SoilParameters(PAPER_LAYERS, BlockSize(14.0, 11.0), mesh),
                         piles=PileGroup(rows=2, cols=3, spacing=3.0, side=0.8, length=6.0),
-                        mesh=MeshSize(h=0.8, growth=1.5, h_max=3.0),
                         observation=Observation(line_points=5, points=((0.5, 0.2, -1.0),)))
 
 

@@ -15,8 +15,11 @@
 """
 Records describing a pier-cap-pile-soil substructure and its load (SI units).
 
-Frozen dataclasses validated on construction: a bad value raises
-:class:`FoundationError` naming the argument, the value and what is allowed.
+Frozen dataclasses whose user-settable fields are declared once with
+:func:`~ttb_sim.parameters.param` (default, unit, range, description): the
+scenario sections ``soil``, ``piles``, ``cap``, ``interface`` and ``load`` are
+these records, so every field is a scenario key. A bad value raises
+:class:`FoundationError` naming the key, the value and what is allowed.
 Checks that involve several records (piles inside the block, pile shorter
 than the deposit, mesh fine enough for the load) are in
 :func:`check_substructure`.
@@ -32,86 +35,47 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 import math
-from typing import Literal, Optional
+from typing import Optional
 
 from ttb_sim.errors import ModelError
+from ttb_sim.model.constants import GRAVITY
+from ttb_sim.parameters import check_declared, param
 
-GRAVITY = 9.81
 #: Side of the square of equal area over the diameter of a circle, sqrt(pi) / 2.
 EQUAL_AREA_SIDE = math.sqrt(math.pi) / 2.0
-
-BoundaryType = Literal['viscoelastic', 'lysmer', 'fixed']
-InterfaceModel = Literal['desai', 'bonded']
-LoadType = Literal['static', 'harmonic', 'pulse']
 
 
 class FoundationError(ModelError):
     """A pile-soil substructure or its load is described by invalid values."""
 
 
-def _check(name: str, value: float, low: float | None = None, high: float | None = None,
-           low_open: bool = False, high_open: bool = False) -> None:
-    """Raise FoundationError unless low <= value <= high (open ends when asked)."""
-    ok = math.isfinite(value)
-    if ok and low is not None:
-        ok = value > low if low_open else value >= low
-    if ok and high is not None:
-        ok = value < high if high_open else value <= high
-    if not ok:
-        lo = '(' if low_open else '['
-        hi = ')' if high_open else ']'
-        allowed = f'{lo}{"-inf" if low is None else f"{low:g}"}, ' \
-                  f'{"inf" if high is None else f"{high:g}"}{hi}'
-        message = f'{name} = {value!r} is outside the allowed range {allowed}'
-        raise FoundationError(message)
-
-
-def _choice(name: str, value: str, allowed: tuple[str, ...]) -> None:
-    if value not in allowed:
-        message = f'{name} = {value!r} is not one of {", ".join(allowed)}'
-        raise FoundationError(message)
+def _check_pair(key: str, value: tuple[float, ...], low: float, high: float) -> None:
+    """Refuse a plan position / frequency pair that is not two finite numbers in [low, high]."""
+    if len(value) != 2 or not all(math.isfinite(v) and low <= v <= high for v in value):
+        raise FoundationError(f'{key} = {list(value)!r} is invalid; allowed: two numbers '
+                              f'in [{low:g}, {high:g}]')
 
 
 @dataclass(frozen=True)
 class SoilLayer:
-    """
-    One horizontal soil layer.
+    """One horizontal soil layer (an entry of ``soil.layers``, top down)."""
 
-    Attributes
-    ----------
-    thickness : float
-        Layer thickness (m), > 0.
-    E : float
-        Young's modulus (Pa), > 0.
-    nu : float
-        Poisson's ratio, in [0, 0.5).
-    rho : float
-        Density (kg/m^3), > 0.
-    c : float
-        Cohesion, used as the interface adhesion (Pa), >= 0.
-    phi : float
-        Friction angle (degrees), in [0, 60].
-    damping_ratio : float
-        Rayleigh damping ratio at the two reference frequencies, in [0, 1).
-
-    """
-
-    thickness: float
-    E: float
-    nu: float
-    rho: float
-    c: float = 10e3
-    phi: float = 30.0
-    damping_ratio: float = 0.05
+    thickness: float = param(2.0, 'm', 'Layer thickness.', low=0.0, high=1000.0,
+                             low_inclusive=False)
+    E: float = param(5e6, 'Pa', "Young's modulus.", low=0.0, high=1e12, low_inclusive=False)
+    nu: float = param(0.3, '-', "Poisson's ratio.", low=0.0, high=0.5, high_inclusive=False)
+    rho: float = param(1900.0, 'kg/m^3', 'Density.', low=0.0, high=1e5, low_inclusive=False)
+    c: float = param(10e3, 'Pa', 'Cohesion, the pile-soil adhesion (interface.adhesion_ratio '
+                     'times it).', low=0.0, high=1e9)
+    phi: float = param(30.0, 'deg', 'Friction angle, the pile-soil friction angle '
+                       '(interface.friction_ratio times its tangent).', low=0.0, high=60.0)
+    damping_ratio: float = param(0.05, '-', 'Rayleigh damping ratio at the two '
+                                 'soil.rayleigh_frequencies.', low=0.0, high=1.0,
+                                 high_inclusive=False)
 
     def __post_init__(self) -> None:
-        _check('soil.layers.thickness', self.thickness, 0.0, low_open=True)
-        _check('soil.layers.E', self.E, 0.0, low_open=True)
-        _check('soil.layers.nu', self.nu, 0.0, 0.5, high_open=True)
-        _check('soil.layers.rho', self.rho, 0.0, low_open=True)
-        _check('soil.layers.c', self.c, 0.0)
-        _check('soil.layers.phi', self.phi, 0.0, 60.0)
-        _check('soil.layers.damping_ratio', self.damping_ratio, 0.0, 1.0, high_open=True)
+        """Check every field against its declaration."""
+        check_declared(self, 'soil.layers.', FoundationError)
 
     @property
     def G(self) -> float:
@@ -137,47 +101,101 @@ PAPER_LAYERS: tuple[SoilLayer, ...] = (
 
 
 @dataclass(frozen=True)
-class SoilBlock:
-    """
-    The layered soil block.
+class BlockSize:
+    """Plan size of the soil block, centred on the origin (its depth is the layers' sum)."""
 
-    Attributes
-    ----------
-    layers : tuple of SoilLayer
-        Top down; the block depth is the sum of the thicknesses.
-    lx, ly : float
-        Plan size (m), > 0.
-    boundary : {'viscoelastic', 'lysmer', 'fixed'}
-        Viscous-spring boundary ([P] Eq. 3) on the sides and base; dashpots
-        only; or base fixed with the sides on rollers.
-    alpha_t, alpha_n : float
-        Viscous-spring coefficients (Liu et al. 3-D values 0.67 and 1.33).
-    boundary_lumping : {'lumped', 'consistent'}
-        Tributary-area or consistent boundary matrices.
-    periodic : bool
-        Lateral faces tied periodically (a site-response column; no piles), with
-        ``boundary`` then acting on the base only.
-
-    """
-
-    layers: tuple[SoilLayer, ...] = PAPER_LAYERS
-    lx: float = 40.0
-    ly: float = 34.0
-    boundary: BoundaryType = 'viscoelastic'
-    alpha_t: float = 0.67
-    alpha_n: float = 1.33
-    boundary_lumping: Literal['lumped', 'consistent'] = 'lumped'
-    periodic: bool = False
+    lx: float = param(40.0, 'm', 'Plan size of the soil block along x (the track).', low=0.0,
+                      high=10000.0, low_inclusive=False)
+    ly: float = param(34.0, 'm', 'Plan size of the soil block along y (across the track).',
+                      low=0.0, high=10000.0, low_inclusive=False)
 
     def __post_init__(self) -> None:
+        """Check every field against its declaration."""
+        check_declared(self, 'soil.block.', FoundationError)
+
+
+@dataclass(frozen=True)
+class MeshSize:
+    """Element sizes of the structured brick mesh (``soil.mesh``)."""
+
+    h: float = param(0.5, 'm', 'Element size in and around the pile group (and along the '
+                     'piles up to soil.mesh.h_shaft).', low=0.0, high=1000.0,
+                     low_inclusive=False)
+    growth: float = param(1.25, '-', 'Size ratio of neighbouring elements away from the '
+                          'group.', low=1.0, high=2.0)
+    h_max: float = param(2.0, 'm', 'Largest element size, far from the group; sets the '
+                         'highest frequency the mesh carries, f_max = Vs_min / '
+                         '(points_per_wavelength h_max).', low=0.0, high=1000.0,
+                         low_inclusive=False)
+    h_shaft: float = param(0.0, 'm', 'Largest vertical element size along the piles; 0 = '
+                           'min(h_max, 4 h).', low=0.0, high=1000.0)
+    max_aspect: float = param(12.0, '-', 'Largest allowed element aspect ratio (longest / '
+                              'shortest edge).', low=1.0, high=1000.0)
+    points_per_wavelength: float = param(8.0, '-', 'Elements per shear wavelength that '
+                                         'define the highest frequency a mesh size carries.',
+                                         low=2.0, high=100.0)
+
+    def __post_init__(self) -> None:
+        """Check every field against its declaration, and h <= h_max."""
+        check_declared(self, 'soil.mesh.', FoundationError)
+        if self.h_max < self.h:
+            raise FoundationError(f'soil.mesh.h_max = {self.h_max!r} is below soil.mesh.h = '
+                                  f'{self.h!r}; allowed: h_max >= h')
+
+    @property
+    def shaft(self) -> float:
+        """Largest vertical element size along the piles (m)."""
+        return self.h_shaft if self.h_shaft > 0 else min(self.h_max, 4 * self.h)
+
+
+@dataclass(frozen=True)
+class SoilParameters:
+    """The layered soil block: layers, plan size, mesh and boundary (``soil``)."""
+
+    layers: tuple[SoilLayer, ...] = param(
+        PAPER_LAYERS, '-', 'Soil layers, top down, each {thickness, E, nu, rho, c, phi, '
+        'damping_ratio} (c, phi and damping_ratio may be left out: 10e3 Pa, 30 deg, 0.05); '
+        "default: [P] Table 5's three layers.")
+    block: BlockSize = field(default_factory=BlockSize)
+    mesh: MeshSize = field(default_factory=MeshSize)
+    boundary: str = param('viscoelastic', '-', "Sides and base: 'viscoelastic' = springs "
+                          'alpha G / R and dashpots rho Vs, rho Vp per unit area ([P] Eq. 3, R '
+                          "from the group centre); 'lysmer' = the dashpots only; 'fixed' = "
+                          'base fixed, sides on rollers.',
+                          choices=('viscoelastic', 'lysmer', 'fixed'))
+    alpha_t: float = param(0.67, '-', 'Tangential coefficient of the viscous-spring boundary '
+                           '(3-D value of Liu et al.).', low=0.0, high=100.0,
+                           low_inclusive=False)
+    alpha_n: float = param(1.33, '-', 'Normal coefficient of the viscous-spring boundary.',
+                           low=0.0, high=100.0, low_inclusive=False)
+    boundary_lumping: str = param('lumped', '-', 'Boundary matrices: tributary-area lumped or '
+                                  'consistent.', choices=('lumped', 'consistent'))
+    periodic: bool = param(False, '-', 'Lateral faces tied periodically (a site-response '
+                           'column without piles; the boundary acts on the base only).')
+    rayleigh_frequencies: tuple[float, ...] = param(
+        (1.0, 20.0), 'Hz', 'The two frequencies at which every material (soil, piles, cap) '
+        'has its damping ratio (Rayleigh damping).', low=0.0, high=1e4, low_inclusive=False)
+
+    def __post_init__(self) -> None:
+        """Check every field against its declaration, and the frequency pair."""
+        check_declared(self, 'soil.', FoundationError)
         if not self.layers:
             raise FoundationError('soil.layers = [] must list at least one layer')
-        _check('soil.block.lx', self.lx, 0.0, low_open=True)
-        _check('soil.block.ly', self.ly, 0.0, low_open=True)
-        _choice('soil.boundary', self.boundary, ('viscoelastic', 'lysmer', 'fixed'))
-        _check('soil.alpha_t', self.alpha_t, 0.0, low_open=True)
-        _check('soil.alpha_n', self.alpha_n, 0.0, low_open=True)
-        _choice('soil.boundary_lumping', self.boundary_lumping, ('lumped', 'consistent'))
+        _check_pair('soil.rayleigh_frequencies', self.rayleigh_frequencies, 1e-6, 1e4)
+        f1, f2 = self.rayleigh_frequencies
+        if f2 <= f1:
+            raise FoundationError(f'soil.rayleigh_frequencies = {[f1, f2]!r}: the second must '
+                                  'be above the first')
+
+    @property
+    def lx(self) -> float:
+        """Plan size along x (m)."""
+        return self.block.lx
+
+    @property
+    def ly(self) -> float:
+        """Plan size along y (m)."""
+        return self.block.ly
 
     @property
     def depth(self) -> float:
@@ -202,52 +220,37 @@ class PileGroup:
     """
     A rectangular group of identical vertical piles with heads at the ground surface.
 
-    Attributes
-    ----------
-    rows, cols : int
-        Number of piles along y and along x, >= 1.
-    spacing : float
-        Centre-to-centre spacing in both directions (m).
-    side, diameter : float or None
-        Square side (m), or a diameter replaced by the equal-area square (0.886 d).
-    length : float
-        Pile length below the ground surface (m).
-    E, nu, rho : float
-        Pile material (Pa, -, kg/m^3).
-    damping_ratio : float
-        Rayleigh damping ratio of the piles.
-    centre : (float, float)
-        Plan position of the group centre (m).
-
+    ``cols`` piles along x and ``rows`` along y; numbered from 1 at the smallest
+    x and y, x running fastest. A circular pile is the square of equal area.
     """
 
-    rows: int = 3
-    cols: int = 5
-    spacing: float = 3.0
-    side: Optional[float] = None
-    diameter: Optional[float] = 1.0
-    length: float = 12.0
-    E: float = 1e11
-    nu: float = 0.2
-    rho: float = 25e3 / GRAVITY
-    damping_ratio: float = 0.02
-    centre: tuple[float, float] = (0.0, 0.0)
+    rows: int = param(3, '-', 'Number of pile rows (piles along y).', low=1, high=50)
+    cols: int = param(5, '-', 'Number of pile columns (piles along x, the track).', low=1,
+                      high=50)
+    spacing: float = param(3.0, 'm', 'Centre-to-centre spacing in both directions.', low=0.0,
+                           high=1000.0, low_inclusive=False)
+    side: float = param(0.0, 'm', 'Side of a square pile; 0 = the square of equal area of '
+                        'piles.diameter (side 0.886 d).', low=0.0, high=100.0)
+    diameter: float = param(1.0, 'm', 'Diameter of a circular pile (used when piles.side '
+                            'is 0).', low=0.0, high=100.0, low_inclusive=False)
+    length: float = param(12.0, 'm', 'Pile length below the ground surface.', low=0.0,
+                          high=1000.0, low_inclusive=False)
+    E: float = param(1e11, 'Pa', "Young's modulus of the piles.", low=0.0, high=1e13,
+                     low_inclusive=False)
+    nu: float = param(0.2, '-', "Poisson's ratio of the piles.", low=0.0, high=0.5,
+                      high_inclusive=False)
+    rho: float = param(25e3 / GRAVITY, 'kg/m^3', 'Density of the piles (25 kN/m^3).', low=0.0,
+                       high=1e5, low_inclusive=False)
+    damping_ratio: float = param(0.02, '-', 'Rayleigh damping ratio of the piles.', low=0.0,
+                                 high=1.0, high_inclusive=False)
+    centre: tuple[float, ...] = param((0.0, 0.0), 'm', 'Plan position (x, y) of the group '
+                                      'centre in the soil block.', low=-5000.0, high=5000.0)
 
     def __post_init__(self) -> None:
-        _check('piles.rows', self.rows, 1)
-        _check('piles.cols', self.cols, 1)
-        if self.side is None and self.diameter is None:
-            raise FoundationError('piles.side and piles.diameter are both unset; give one')
-        if self.side is not None:
-            _check('piles.side', self.side, 0.0, low_open=True)
-        if self.diameter is not None and self.side is None:
-            _check('piles.diameter', self.diameter, 0.0, low_open=True)
-        _check('piles.length', self.length, 0.0, low_open=True)
-        _check('piles.E', self.E, 0.0, low_open=True)
-        _check('piles.nu', self.nu, 0.0, 0.5, high_open=True)
-        _check('piles.rho', self.rho, 0.0, low_open=True)
-        _check('piles.damping_ratio', self.damping_ratio, 0.0, 1.0, high_open=True)
-        if self.rows * self.cols > 1 and self.spacing <= self.width:
+        """Check every field against its declaration, the centre and the spacing."""
+        check_declared(self, 'piles.', FoundationError)
+        _check_pair('piles.centre', self.centre, -5000.0, 5000.0)
+        if self.count > 1 and self.spacing <= self.width:
             message = (f'piles.spacing = {self.spacing!r} m makes the piles (width '
                        f'{self.width:.4g} m) overlap or touch; allowed: > {self.width:.4g} m')
             raise FoundationError(message)
@@ -255,10 +258,7 @@ class PileGroup:
     @property
     def width(self) -> float:
         """Side of the (equivalent) square pile (m)."""
-        if self.side is not None:
-            return float(self.side)
-        assert self.diameter is not None
-        return EQUAL_AREA_SIDE * float(self.diameter)
+        return float(self.side) if self.side > 0 else EQUAL_AREA_SIDE * float(self.diameter)
 
     @property
     def count(self) -> int:
@@ -275,122 +275,100 @@ class PileGroup:
 
 @dataclass(frozen=True)
 class Cap:
-    """
-    The pile cap: solid elements on the ground surface, bonded to the pile heads.
+    """The pile cap: solid elements on the ground surface, bonded to the pile heads."""
 
-    Attributes
-    ----------
-    enabled : bool
-        Whether the cap is modelled.
-    lx, ly, thickness : float
-        Plan size and thickness (m) ([P] Table 6: 15 x 9 x 2.5 m).
-    E, nu, rho, damping_ratio : float
-        Material (Pa, -, kg/m^3, -).
-
-    """
-
-    enabled: bool = False
-    lx: float = 15.0
-    ly: float = 9.0
-    thickness: float = 2.5
-    E: float = 3.25e10
-    nu: float = 0.2
-    rho: float = 2500.0
-    damping_ratio: float = 0.02
+    enabled: bool = param(False, '-', 'Model the cap (for the coupled model; the '
+                          'substructure scenarios leave the pile heads free).')
+    lx: float = param(15.0, 'm', 'Cap size along x ([P] Table 6).', low=0.0, high=1000.0,
+                      low_inclusive=False)
+    ly: float = param(9.0, 'm', 'Cap size along y ([P] Table 6).', low=0.0, high=1000.0,
+                      low_inclusive=False)
+    thickness: float = param(2.5, 'm', 'Cap thickness ([P] Table 6).', low=0.0, high=100.0,
+                             low_inclusive=False)
+    E: float = param(3.25e10, 'Pa', "Young's modulus of the cap.", low=0.0, high=1e13,
+                     low_inclusive=False)
+    nu: float = param(0.2, '-', "Poisson's ratio of the cap.", low=0.0, high=0.5,
+                      high_inclusive=False)
+    rho: float = param(2500.0, 'kg/m^3', 'Density of the cap.', low=0.0, high=1e5,
+                       low_inclusive=False)
+    damping_ratio: float = param(0.02, '-', 'Rayleigh damping ratio of the cap.', low=0.0,
+                                 high=1.0, high_inclusive=False)
 
     def __post_init__(self) -> None:
-        _check('cap.lx', self.lx, 0.0, low_open=True)
-        _check('cap.ly', self.ly, 0.0, low_open=True)
-        _check('cap.thickness', self.thickness, 0.0, low_open=True)
-        _check('cap.E', self.E, 0.0, low_open=True)
-        _check('cap.nu', self.nu, 0.0, 0.5, high_open=True)
-        _check('cap.rho', self.rho, 0.0, low_open=True)
-        _check('cap.damping_ratio', self.damping_ratio, 0.0, 1.0, high_open=True)
+        """Check every field against its declaration."""
+        check_declared(self, 'cap.', FoundationError)
 
 
 @dataclass(frozen=True)
 class Interface:
-    """
-    The pile-soil interface.
+    """The pile-soil interface (see :mod:`.desai`)."""
 
-    Attributes
-    ----------
-    model : {'desai', 'bonded'}
-        Desai thin-layer elements between duplicated nodes, or shared nodes.
-    thickness : float
-        Notional layer thickness t (m); [P] takes 0.01-0.1 of the element size.
-    failure_ratio : float
-        Clough-Duncan R_f, in (0, 1).
-    friction_ratio, adhesion_ratio : float
-        tan(delta) / tan(phi) and adhesion / cohesion of the adjacent layer.
-    shear_modulus : {'G', 'lame'}
-        Initial shear modulus of the layer (see :mod:`.desai`).
-    k0 : float or None
-        Earth pressure coefficient on the shafts; None takes Jaky's 1 - sin(phi).
-
-    """
-
-    model: InterfaceModel = 'desai'
-    thickness: float = 0.02
-    failure_ratio: float = 0.9
-    friction_ratio: float = 1.0
-    adhesion_ratio: float = 1.0
-    shear_modulus: Literal['G', 'lame'] = 'G'
-    k0: Optional[float] = None
+    model: str = param('desai', '-', "'desai': Desai thin-layer elements between duplicated "
+                       "nodes on the pile shafts and tips ([P] Eqs. 4-10); 'bonded': shared "
+                       'nodes.', choices=('desai', 'bonded'))
+    thickness: float = param(0.02, 'm', 'Notional thickness t of the thin layer ([P]: 0.01 to '
+                             '0.1 of the element size).', low=0.0, high=10.0,
+                             low_inclusive=False)
+    failure_ratio: float = param(0.9, '-', 'Clough-Duncan failure ratio R_f.', low=0.0,
+                                 high=1.0, low_inclusive=False, high_inclusive=False)
+    friction_ratio: float = param(1.0, '-', 'tan(delta) / tan(phi) of the adjacent layer.',
+                                  low=0.0, high=1.0)
+    adhesion_ratio: float = param(1.0, '-', 'Adhesion over the cohesion c of the adjacent '
+                                  'layer.', low=0.0, high=1.0)
+    shear_modulus: str = param('G', '-', 'Initial shear modulus of the thin layer: the '
+                               "layer's G, or Lame's lambda as [P] Eq. 9 reads.",
+                               choices=('G', 'lame'))
+    k0: float = param(0.0, '-', 'Earth pressure coefficient on the shafts; 0 = Jaky, '
+                      '1 - sin(phi).', low=0.0, high=3.0)
 
     def __post_init__(self) -> None:
-        _choice('interface.model', self.model, ('desai', 'bonded'))
-        _check('interface.thickness', self.thickness, 0.0, low_open=True)
-        _check('interface.failure_ratio', self.failure_ratio, 0.0, 1.0, True, True)
-        _check('interface.friction_ratio', self.friction_ratio, 0.0, 1.0)
-        _check('interface.adhesion_ratio', self.adhesion_ratio, 0.0, 1.0)
-        _choice('interface.shear_modulus', self.shear_modulus, ('G', 'lame'))
-        if self.k0 is not None:
-            _check('interface.k0', self.k0, 0.0, 3.0)
+        """Check every field against its declaration."""
+        check_declared(self, 'interface.', FoundationError)
+
+
+_LOAD_TYPES = ("'static' (one frame at t = 0 with the static solution), 'harmonic' "
+               "(A sin(2 pi f t) from rest at t = 0), 'pulse' (one half sine of duration "
+               "1 / (2 f)); 'none' = no substructure load (a train run).")
 
 
 @dataclass(frozen=True)
-class MeshSize:
+class PileLoad:
     """
-    Element sizes of the structured mesh.
+    A load on the pile-soil substructure alone (``load``).
 
-    Attributes
-    ----------
-    h : float
-        Element size in and around the pile group (m).
-    growth : float
-        Size ratio of neighbouring elements away from the group, in [1, 2].
-    h_max : float
-        Largest element size (m).
-    h_shaft : float or None
-        Largest vertical size along the piles (m); None takes min(h_max, 4 h).
-    max_aspect : float
-        Largest allowed element aspect ratio (longest / shortest edge).
-    points_per_wavelength : float
-        Elements per shear wavelength that define the highest frequency carried.
-
+    ``type`` 'none' (the default) means no substructure load: the scenario is a
+    train run. Any other type makes the scenario a substructure-only run.
     """
 
-    h: float = 0.5
-    growth: float = 1.25
-    h_max: float = 2.0
-    h_shaft: Optional[float] = None
-    max_aspect: float = 12.0
-    points_per_wavelength: float = 8.0
+    type: str = param('none', '-', _LOAD_TYPES,  # noqa: A003 - the contract key is load.type
+                      choices=('none', 'static', 'harmonic', 'pulse'))
+    amplitude: float = param(10e3, 'N', 'Force amplitude.', low=-1e10, high=1e10)
+    frequency: float = param(20.0, 'Hz', 'Frequency of a harmonic load or pulse.', low=0.0,
+                             high=1e4, low_inclusive=False)
+    pile: int = param(5, '-', 'Loaded pile, 1-based (from the smallest x and y, x running '
+                      'fastest).', low=1, high=2500)
+    direction: str = param('z', '-', 'Direction of the force.', choices=('x', 'y', 'z'))
+    target: str = param('pile', '-', "'pile': a uniform pressure on the pile head; "
+                        "'surface': on the whole ground surface.",
+                        choices=('pile', 'surface'))
 
     def __post_init__(self) -> None:
-        _check('soil.mesh.h', self.h, 0.0, low_open=True)
-        _check('soil.mesh.growth', self.growth, 1.0, 2.0)
-        _check('soil.mesh.h_max', self.h_max, self.h)
-        if self.h_shaft is not None:
-            _check('soil.mesh.h_shaft', self.h_shaft, 0.0, low_open=True)
-        _check('soil.mesh.max_aspect', self.max_aspect, 1.0)
-        _check('soil.mesh.points_per_wavelength', self.points_per_wavelength, 2.0)
+        """Check every field against its declaration."""
+        check_declared(self, 'load.', FoundationError)
 
     @property
-    def shaft(self) -> float:
-        """Largest vertical element size along the piles (m)."""
-        return self.h_shaft if self.h_shaft is not None else min(self.h_max, 4 * self.h)
+    def kind(self) -> str:
+        """The load type (``type``)."""
+        return self.type
+
+    def history(self, t: float) -> float:
+        """Return the load factor at time t (s)."""
+        if self.type in ('static', 'none'):
+            return 1.0
+        w = 2 * math.pi * self.frequency
+        if self.type == 'harmonic':
+            return math.sin(w * t)
+        return math.sin(w * t) if 0.0 <= t <= 0.5 / self.frequency else 0.0
 
 
 @dataclass(frozen=True)
@@ -413,87 +391,40 @@ class Observation:
 
     line_points: int = 21
     val_points: bool = True
-    points: tuple[tuple[float, float, float], ...] = ()
+    points: tuple[tuple[float, ...], ...] = ()
 
 
 @dataclass(frozen=True)
 class Substructure:
     """
-    A pile-soil substructure: soil, piles (or none), cap, interface, mesh.
+    A pile-soil substructure: soil, piles (or none), cap, interface, observation.
 
     Attributes
     ----------
     name : str
         Group name (``pier01`` for a substructure-only scenario).
-    soil, piles, cap, interface, mesh, observation : records
+    soil, piles, cap, interface, observation : records
         The parts; ``piles=None`` is a soil block without piles.
-    rayleigh_frequencies : (float, float)
-        The two frequencies (Hz) at which every material has its damping ratio.
 
     """
 
     name: str = 'pier01'
-    soil: SoilBlock = field(default_factory=SoilBlock)
+    soil: SoilParameters = field(default_factory=SoilParameters)
     piles: Optional[PileGroup] = field(default_factory=PileGroup)
     cap: Cap = field(default_factory=Cap)
     interface: Interface = field(default_factory=Interface)
-    mesh: MeshSize = field(default_factory=MeshSize)
     observation: Observation = field(default_factory=Observation)
-    rayleigh_frequencies: tuple[float, float] = (1.0, 20.0)
 
-    def __post_init__(self) -> None:
-        f1, f2 = self.rayleigh_frequencies
-        _check('soil.rayleigh_frequencies[0]', f1, 0.0, low_open=True)
-        _check('soil.rayleigh_frequencies[1]', f2, f1, low_open=True)
+    @property
+    def mesh(self) -> MeshSize:
+        """Element sizes (``soil.mesh``)."""
+        return self.soil.mesh
 
-
-@dataclass(frozen=True)
-class PileLoad:
-    """
-    A load on the substructure.
-
-    Attributes
-    ----------
-    kind : {'static', 'harmonic', 'pulse'}
-        (scenario key ``load.type``)
-        Constant; A sin(2 pi f t) from t = 0; one half sine of duration 1 / (2 f).
-    amplitude : float
-        Force (N).
-    frequency : float
-        Hz (harmonic, pulse).
-    pile : int
-        Loaded pile, 1-based (target 'pile').
-    direction : {'x', 'y', 'z'}
-        Direction of the force.
-    target : {'pile', 'surface'}
-        A uniform pressure on the pile's head, or on the whole ground surface.
-
-    """
-
-    kind: LoadType = 'harmonic'
-    amplitude: float = 10e3
-    frequency: float = 20.0
-    pile: int = 5
-    direction: Literal['x', 'y', 'z'] = 'z'
-    target: Literal['pile', 'surface'] = 'pile'
-
-    def __post_init__(self) -> None:
-        _choice('load.type', self.kind, ('static', 'harmonic', 'pulse'))
-        _check('load.amplitude', self.amplitude)
-        if self.kind != 'static':
-            _check('load.frequency', self.frequency, 0.0, low_open=True)
-        _check('load.pile', self.pile, 1)
-        _choice('load.direction', self.direction, ('x', 'y', 'z'))
-        _choice('load.target', self.target, ('pile', 'surface'))
-
-    def history(self, t: float) -> float:
-        """Return the load factor at time t (s)."""
-        if self.kind == 'static':
-            return 1.0
-        w = 2 * math.pi * self.frequency
-        if self.kind == 'harmonic':
-            return math.sin(w * t)
-        return math.sin(w * t) if 0.0 <= t <= 0.5 / self.frequency else 0.0
+    @property
+    def rayleigh_frequencies(self) -> tuple[float, float]:
+        """The two Rayleigh reference frequencies (Hz)."""
+        f1, f2 = self.soil.rayleigh_frequencies
+        return float(f1), float(f2)
 
 
 def check_substructure(spec: Substructure, load: Optional[PileLoad] = None) -> None:
@@ -535,13 +466,22 @@ def check_substructure(spec: Substructure, load: Optional[PileLoad] = None) -> N
                     or max(abs(y) for y in ys) + half > 0.5 * spec.cap.ly + 1e-9):
                 raise FoundationError(f'the cap ({spec.cap.lx:g} x {spec.cap.ly:g} m) does '
                                       'not cover the pile heads')
-    if load is not None:
+    top = spec.cap.thickness if spec.cap.enabled and piles is not None else 0.0
+    for i, point in enumerate(spec.observation.points):
+        x, y, z = point
+        if not (abs(x) <= 0.5 * soil.lx and abs(y) <= 0.5 * soil.ly
+                and -soil.depth <= z <= top):
+            raise FoundationError(
+                f'output.soil_points[{i}] = {list(point)!r} lies outside the soil block; '
+                f'allowed: |x| <= {0.5 * soil.lx:g}, |y| <= {0.5 * soil.ly:g}, '
+                f'{-soil.depth:g} <= z <= {top:g} m (soil.block.lx, soil.block.ly, soil.layers)')
+    if load is not None and load.type != 'none':
         if load.target == 'pile':
             count = piles.count if piles is not None else 0
             if load.pile > count:
                 message = f'load.pile = {load.pile!r}; allowed: 1 .. {count} (piles in group)'
                 raise FoundationError(message)
-        if load.kind != 'static':
+        if load.type != 'static':
             carried = soil.vs_min / (spec.mesh.points_per_wavelength * spec.mesh.h)
             largest = soil.vs_min / (spec.mesh.points_per_wavelength * load.frequency)
             if load.frequency > carried:

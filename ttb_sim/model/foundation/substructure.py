@@ -57,9 +57,10 @@ from ttb_sim.fe.boundary import face_matrices, viscoelastic_coefficients
 from ttb_sim.fe.interface import interface_set, InterfaceSet
 from ttb_sim.fe.mesh import graded_planes, Grid, HEX_FACES, Mesh, node_dofs
 from ttb_sim.fe.quad import face_frames, FACE_N
+from ttb_sim.model.constants import GRAVITY
 from ttb_sim.model.foundation.desai import DesaiLaw, initial_moduli
-from ttb_sim.model.foundation.records import (check_substructure, FoundationError, GRAVITY,
-                                              PileLoad, Substructure)
+from ttb_sim.model.foundation.records import (check_substructure, FoundationError, PileLoad,
+                                              Substructure)
 
 LOG = logging.getLogger(__name__)
 
@@ -245,6 +246,12 @@ def vertical_stress(z: np.ndarray, spec: Substructure) -> np.ndarray:
         out += layer.rho * GRAVITY * inside
         top = bottom
     return out
+
+
+def planned_nodes(spec: Substructure) -> int:
+    """Return the number of grid nodes the mesh of ``spec`` will have (cheap: planes only)."""
+    nx, ny, nz = _planes(spec).shape
+    return nx * ny * nz
 
 
 def build(spec: Substructure, load: Optional[PileLoad] = None) -> PileSoilModel:
@@ -443,9 +450,10 @@ def build(spec: Substructure, load: Optional[PileLoad] = None) -> PileSoilModel:
         nu_l = np.array([x.nu for x in soil.layers])[lay]
         phi = np.radians(np.array([x.phi for x in soil.layers]))[lay]
         c_l = np.array([x.c for x in soil.layers])[lay]
-        k_n0, k_s0 = initial_moduli(e_l, nu_l, spec.interface.shear_modulus)
+        k_n0, k_s0 = initial_moduli(e_l, nu_l, 'lame' if spec.interface.shear_modulus == 'lame'
+                                    else 'G')
         sigma_v = vertical_stress(gp[..., 2], spec)
-        k0 = (1 - np.sin(phi)) if spec.interface.k0 is None else spec.interface.k0
+        k0 = (1 - np.sin(phi)) if spec.interface.k0 <= 0 else spec.interface.k0
         vertical = np.abs(iface.frames[:, :, 0, 2]) > 0.5
         sigma_n0 = np.where(vertical, sigma_v, k0 * sigma_v)
         law = DesaiLaw(k_n0, k_s0, spec.interface.adhesion_ratio * c_l,
@@ -505,7 +513,8 @@ def build(spec: Substructure, load: Optional[PileLoad] = None) -> PileSoilModel:
              '%d interface elements, f_max %.3g Hz', len(nodes), n_dofs,
              summary['soil_cells'], summary['pile_cells'], summary['cap_cells'],
              summary['interface_elements'], summary['f_max'])
-    if load is not None and load.kind != 'static' and load.frequency > summary['f_max']:
+    dynamic = load is not None and load.type not in ('static', 'none')
+    if dynamic and load is not None and load.frequency > summary['f_max']:
         LOG.warning('load frequency %.3g Hz is above the %.3g Hz the coarsest soil elements '
                     'carry: outgoing waves are under-resolved far from the piles',
                     load.frequency, summary['f_max'])

@@ -210,12 +210,15 @@ class TrainTrackCoupling:
         self.head_arm = np.array([0.0, 0.0, track.rail_head])
         ftf = structure.full_to_free
         self.rail_dofs = tuple(ftf[r.dofs] for r in self.rails)
-        self.compliance = RailCompliance(integrator, self.rails, ftf)
+        self.compliance = self._rail_compliance(integrator, ftf)
         self._no_load = np.zeros(structure.n_full)   # read-only, shared by every frame
         self._speed = math.nan
         self.tol = cc.tolerance
         self.max_iter = cc.max_iterations
-        n_free = structure.n_free
+        n_free = self.n_free = structure.n_free
+        """Size of the solved track-bridge state (all free DOFs here)."""
+        self.static_stiffness = structure.stiffness
+        """Stiffness of the solved state, for the static equilibrium."""
         self.u = np.zeros(n_free)
         self.v = np.zeros(n_free)
         self.a = np.zeros(n_free)
@@ -229,6 +232,11 @@ class TrainTrackCoupling:
         self._rail_y = np.zeros((n, 8))
         self._rail_offset = np.zeros((n, 8, COMPONENTS))
         self._wheelset_y = 6 * np.repeat(np.arange(3, 7), 2) + 1
+
+    def _rail_compliance(self, integrator: Integrator,
+                         full_to_free: np.ndarray) -> RailCompliance:
+        """Return the local rail compliance blocks of the solved system."""
+        return RailCompliance(integrator, self.rails, full_to_free)
 
     # -- geometry and kinematics ---------------------------------------------------------
     def _rail_rows(self, x: np.ndarray
@@ -312,7 +320,6 @@ class TrainTrackCoupling:
         The wheelsets stand centred on the track; vertical irregularity and the
         rigid-contact height change caused by lateral irregularity are included.
         """
-        st = self.structure
         n = self.n_cars
         x = head + self.contact_x
         rows, _, dofs, _ = self._rail_rows(x)
@@ -321,9 +328,9 @@ class TrainTrackCoupling:
         # the rails are shifted under them, which raises or lowers each wheel's
         # rigid-contact height; the static loads and attitude take that in.
         irr_z = irr_z + self._geometry(-irr_y)[2]
-        n_free = st.n_free
+        n_free = self.n_free
         m = 8 * n
-        lu = factorize(st.stiffness, method=self.nm.method)
+        lu = factorize(self.static_stiffness, method=self.nm.method)
         rhs = np.zeros((n_free + 1, m))
         flat = dofs.reshape(m, 12)
         rz = rows[..., 2, :].reshape(m, 12)
@@ -415,7 +422,7 @@ class TrainTrackCoupling:
         """Advance train, track and bridge together to the head position ``head``."""
         self._update_speed(speed)
         nm, n = self.nm, self.n_cars
-        n_free = self.structure.n_free
+        n_free = self.n_free
         x = head + self.contact_x
         rows, slope, dofs, blocks = self._rail_rows(x)
         irr_z, irr_y, irr_dy = self._irregularity(x)

@@ -1,0 +1,80 @@
+# Copyright 2026 The ttb_sim Authors
+#
+# Licensed under the Apache License, Version 2.0 (the "License");
+# you may not use this file except in compliance with the License.
+# You may obtain a copy of the License at
+#
+#     http://www.apache.org/licenses/LICENSE-2.0
+#
+# Unless required by applicable law or agreed to in writing, software
+# distributed under the License is distributed on an "AS IS" BASIS,
+# WITHOUT WARRANTIES OR CONDITIONS OF ANY KIND, either express or implied.
+# See the License for the specific language governing permissions and
+# limitations under the License.
+
+"""
+The ``analyze`` verb: one bag -> figures, ``metrics.json`` and ``index.html``.
+
+The bag is read and every metric computed before the output folder is
+touched; figures are written into a staging folder renamed into place at the
+end (:func:`ttb_sim.commands.report_html.staged_output`), so a failure leaves no
+folder that looks complete.
+"""
+
+from __future__ import annotations
+
+import logging
+from pathlib import Path
+import sys
+import time
+
+from ttb_sim.commands.report import bag_metrics
+from ttb_sim.commands.report_figures import write_figures
+from ttb_sim.commands.report_html import check_output, staged_output, write_index, write_json
+from ttb_sim.commands.streams import load_streams
+
+log = logging.getLogger(__name__)
+
+EXIT_OK = 0
+
+
+def default_output(bag: Path) -> Path:
+    """Return the default output folder: ``analysis/`` inside the bag directory."""
+    return (bag if bag.is_dir() else bag.parent) / 'analysis'
+
+
+def analyze(bag: str | Path, *, out: str | Path | None = None) -> int:
+    """
+    Run ``ttb-sim analyze``; return the exit code.
+
+    Raises
+    ------
+    BagError
+        When the bag is missing, not a bag, truncated or has no stream to analyse.
+    ScenarioError
+        When ``out`` cannot be written.
+
+    """
+    start = time.perf_counter()
+    path = Path(bag)
+    target = Path(out) if out is not None else default_output(path)
+    check_output(target)
+    streams = load_streams(path)
+    read = time.perf_counter() - start
+    metrics = bag_metrics(streams)
+    with staged_output(target) as stage:
+        written, skipped = write_figures([streams], stage, [metrics])
+        metrics['figures'] = {n.name: n.text for n in written}
+        metrics['figures_skipped'] = {n.name: n.text for n in skipped}
+        metrics['analysis_time_s'] = time.perf_counter() - start
+        write_json(stage / 'metrics.json', metrics)
+        write_index(stage, f'ttb-sim analyze: {streams.label}', [streams.label], [str(path)],
+                    [metrics], written, skipped)
+    elapsed = time.perf_counter() - start
+    if skipped:
+        print(f'ttb-sim: skipped {len(skipped)} figures ({", ".join(n.name for n in skipped)}):'
+              ' the bag lacks their streams; reasons in index.html and metrics.json',
+              file=sys.stderr)
+    print(f'{target}: {len(written)} figures, metrics.json, index.html '
+          f'({len(skipped)} skipped; read {read:.1f} s, total {elapsed:.1f} s)')
+    return EXIT_OK

@@ -1,0 +1,134 @@
+# Copyright 2026 The ttb_sim Authors
+#
+# Licensed under the Apache License, Version 2.0 (the "License");
+# you may not use this file except in compliance with the License.
+# You may obtain a copy of the License at
+#
+#     http://www.apache.org/licenses/LICENSE-2.0
+#
+# Unless required by applicable law or agreed to in writing, software
+# distributed under the License is distributed on an "AS IS" BASIS,
+# WITHOUT WARRANTIES OR CONDITIONS OF ANY KIND, either express or implied.
+# See the License for the specific language governing permissions and
+# limitations under the License.
+
+"""
+The ``compare`` verb: several bags -> the analysis figures overlaid and a table of differences.
+
+Typical use is [P] Example 1, ``paper_ttbi`` against ``paper_ttbcpsi``.  Every
+bag is read and its metrics computed before anything is written; the figures
+carry one trace per bag (labels from ``--labels`` or the bag folder names);
+``differences.csv`` and the page list every numeric metric of every bag with
+its difference from the first bag (absolute and relative).
+"""
+
+from __future__ import annotations
+
+import csv
+import logging
+from pathlib import Path
+import sys
+import time
+from typing import Any, Sequence
+
+from ttb_sim.commands.report import bag_metrics
+from ttb_sim.commands.report_figures import write_figures
+from ttb_sim.commands.report_html import check_output, staged_output, write_index, write_json
+from ttb_sim.commands.streams import load_streams
+from ttb_sim.errors import ScenarioError
+from ttb_sim.io.bag import default_bag_path
+
+log = logging.getLogger(__name__)
+
+EXIT_OK = 0
+
+
+def flatten(metrics: dict[str, Any], prefix: str = '') -> dict[str, float]:
+    """Return the numeric leaves of a metrics tree as {'a.b.c': value} (lists left out)."""
+    out: dict[str, float] = {}
+    for key, value in metrics.items():
+        name = f'{prefix}{key}'
+        if isinstance(value, dict):
+            out.update(flatten(value, name + '.'))
+        elif isinstance(value, (int, float)) and not isinstance(value, bool):
+            out[name] = float(value)
+    return out
+
+
+def differences(labels: Sequence[str], metrics: Sequence[dict[str, Any]]) -> list[list[Any]]:
+    """
+    Return rows (metric, value per bag, then per other bag: difference and relative difference).
+
+    Differences are against the first bag; the relative one is None where the
+    first bag's value is 0. Bookkeeping numbers (durations, rates, times) are left out.
+    """
+    flat = [flatten({k: v for k, v in m.items()
+                     if k not in ('analysis_time_s', 'duration_s', 'sample_rate_hz',
+                                  'excitation_hz')}) for m in metrics]
+    keys: list[str] = []
+    for f in flat:
+        keys.extend(k for k in f if k not in keys and not k.endswith('.limit'))
+    rows = []
+    for key in keys:
+        values = [f.get(key) for f in flat]
+        row: list[Any] = [key, *values]
+        base = values[0]
+        for v in values[1:]:
+            if base is None or v is None:
+                row.extend([None, None])
+            else:
+                row.extend([v - base, (v - base) / abs(base) if base else None])
+        rows.append(row)
+    return rows
+
+
+def _labels(bags: Sequence[Path], labels: str | Sequence[str] | None) -> list[str]:
+    if labels is None:
+        names = [b.name if b.is_dir() else b.stem for b in bags]
+        if len(set(names)) < len(names):
+            names = [f'{i + 1}:{n}' for i, n in enumerate(names)]
+        return names
+    given = [s.strip() for s in labels.split(',')] if isinstance(labels, str) else list(labels)
+    if len(given) != len(bags) or not all(given) or len(set(given)) != len(given):
+        raise ScenarioError(f'--labels {",".join(given)!r} must give {len(bags)} distinct '
+                            f'non-empty labels, one per bag, comma-separated')
+    return given
+
+
+def compare(bags: Sequence[str | Path], *, labels: str | Sequence[str] | None = None,
+            out: str | Path | None = None) -> int:
+    """Run ``ttb-sim compare``; return the exit code (BagError / ScenarioError: exit 2)."""
+    start = time.perf_counter()
+    paths = [Path(b) for b in bags]
+    if len(paths) < 2:
+        raise ScenarioError(f'compare needs at least two bags, got {len(paths)}')
+    names = _labels(paths, labels)
+    target = Path(out) if out is not None else default_bag_path('compare')
+    check_output(target)
+    streams = [load_streams(p, label) for p, label in zip(paths, names)]
+    metrics = [bag_metrics(s) for s in streams]
+    rows = differences(names, metrics)
+    head = ['metric', *names]
+    for other in names[1:]:
+        head.extend([f'{other} - {names[0]}', f'relative ({other})'])
+    with staged_output(target) as stage:
+        written, skipped = write_figures(streams, stage, metrics)
+        write_json(stage / 'metrics.json', {
+            'bags': dict(zip(names, metrics)),
+            'differences': [dict(zip(head, r)) for r in rows],
+            'figures': {n.name: n.text for n in written},
+            'figures_skipped': {n.name: n.text for n in skipped},
+            'analysis_time_s': time.perf_counter() - start})
+        with (stage / 'differences.csv').open('w', newline='') as fh:
+            writer = csv.writer(fh)
+            writer.writerow(head)
+            writer.writerows(['' if c is None else c for c in r] for r in rows)
+        write_index(stage, f'ttb-sim compare: {" vs ".join(names)}', names,
+                    [str(p) for p in paths], metrics, written, skipped,
+                    extra=[(f'Differences from {names[0]}', head, rows)])
+    if skipped:
+        print(f'ttb-sim: skipped {len(skipped)} figures ({", ".join(n.name for n in skipped)}):'
+              ' no bag has their streams; reasons in index.html', file=sys.stderr)
+    print(f'{target}: {len(written)} figures, differences.csv, metrics.json, index.html '
+          f'({time.perf_counter() - start:.1f} s)')
+    return EXIT_OK

@@ -1,0 +1,369 @@
+# Copyright 2026 The ttb_sim Authors
+#
+# Licensed under the Apache License, Version 2.0 (the "License");
+# you may not use this file except in compliance with the License.
+# You may obtain a copy of the License at
+#
+#     http://www.apache.org/licenses/LICENSE-2.0
+#
+# Unless required by applicable law or agreed to in writing, software
+# distributed under the License is distributed on an "AS IS" BASIS,
+# WITHOUT WARRANTIES OR CONDITIONS OF ANY KIND, either express or implied.
+# See the License for the specific language governing permissions and
+# limitations under the License.
+
+"""
+Metrics and figures of bags, shared by ``ttb-sim analyze`` (one bag) and ``compare`` (several).
+
+:func:`bag_metrics` computes the numbers of one :class:`Streams` (written to
+``metrics.json``); :func:`write_figures` draws every figure the bags have the
+streams for, each bag a trace, and returns what it wrote and what it skipped
+with the reason.  The physics lives in :mod:`ttb_sim.analysis`; this module
+only picks the streams and lays them out.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+import logging
+import math
+import re
+from typing import Any
+
+import numpy as np
+
+from ttb_sim.analysis.excitation import Excitation, excitation_frequencies
+from ttb_sim.analysis.levels import total_level, vibration_levels
+from ttb_sim.analysis.power_flow import power_flow_spectrum, velocity_from_displacement
+from ttb_sim.analysis.psd import (level_change_frequency, peak_frequency,
+                                  resolving_segment_seconds, welch_psd)
+from ttb_sim.analysis.ride import CAR_BODY_LIMITS, sperling_grade, sperling_index
+from ttb_sim.analysis.safety import (deck_acceleration, derailment_coefficient,
+                                     lateral_force_limit, LIMITS, wheel_load_reduction)
+from ttb_sim.analysis.weighting import weighted_rms
+from ttb_sim.commands.streams import Series, Streams
+
+log = logging.getLogger(__name__)
+
+CAR_BODY_LOWEST_HZ = 0.84
+"""Lowest frequency of interest of car bodies: the vertical bounce mode of [P] Table 1 cars."""
+SPERLING_LIMIT = 2.5
+"""Sperling index below which a passenger car rates 'excellent'."""
+_OBSERVER = re.compile(r'^\s*([^=\s]+)\s*=\s*(\w+)\s*@\s*([-+0-9.eE]+)\s*$')
+_LAYERS = ('rail', 'slab', 'base', 'girder')
+
+
+@dataclass(frozen=True)
+class FigureNote:
+    """A figure written (file, caption) or skipped (file, reason)."""
+
+    name: str
+    text: str
+
+
+# -- excitation marks ---------------------------------------------------------------------
+
+def marks_of(s: Streams) -> list[Excitation]:
+    """Return the excitation frequencies of a bag (train speed, scenario echo, harmonic load)."""
+    load = s.section('load')
+    if load.get('type') == 'harmonic' and load.get('frequency'):
+        return [Excitation('harmonic load', float(load['frequency']), float(load['frequency']))]
+    if not s.speed:
+        return []
+    car, train = s.section('car'), s.section('train')
+    track, bridge = s.section('track'), s.section('bridge')
+    spectrum = str(s.section('irregularity').get('spectrum', 'paper'))
+    slab = track.get('model') == 'slab'
+    slab_length = None
+    if slab and track.get('fasteners_per_slab'):
+        slab_length = track['fasteners_per_slab'] * track['fastener_spacing'] + \
+            track.get('slab_gap', 0.0)
+    return excitation_frequencies(
+        s.speed, boundary_wavelength=1.0 if spectrum in ('paper', 'chinese_sato') else None,
+        bogie_semi_spacing=car.get('bogie_semi_spacing'), wheelbase_semi=car.get('wheelbase_semi'),
+        car_length=train.get('car_length') if train.get('vehicle') == 'car' or
+        not train.get('axle_offsets') else None,
+        span_length=bridge.get('span_length'), slab_length=slab_length,
+        fastener_spacing=track.get('fastener_spacing') if slab else None)
+
+
+# -- metrics -----------------------------------------------------------------------------
+
+def _index(value: float, limit: float, unit: str, where: str) -> dict[str, Any]:
+    return {'value': float(value), 'limit': float(limit), 'unit': unit, 'where': where,
+            'within_limit': bool(value <= limit)}
+
+
+def _psd(series: Series, column: int, lowest_hz: float) -> tuple[np.ndarray, np.ndarray]:
+    x = series.values[:, column]
+    seconds = resolving_segment_seconds(lowest_hz, series.t.size / series.rate)
+    return welch_psd(x, series.rate, segment_seconds=min(seconds, x.size / series.rate))
+
+
+def _body_peak(series: Series) -> float | None:
+    """Return the car-body vertical PSD peak in 0.3-3 Hz (None: record too short, or no peak)."""
+    if series.t.size / series.rate < 4.0 or not np.any(series.values[:, 2]):
+        return None   # bins coarser than 0.25 Hz cannot place the 0.84 Hz mode
+    f, p = _psd(series, 2, CAR_BODY_LOWEST_HZ)
+    band = np.flatnonzero((f >= 0.3) & (f <= 3.0))
+    if band.size < 3:
+        return None
+    i = band[np.argmax(p[band])]
+    if i in (band[0], band[-1]):
+        return None   # the maximum is on an edge: no peak inside the band
+    return peak_frequency(f, p, (0.3, 3.0))
+
+
+def bag_metrics(s: Streams) -> dict[str, Any]:
+    """Return the metrics of one bag (JSON-ready): peaks, spectra features, ride and safety."""
+    out: dict[str, Any] = {
+        'bag': str(s.path), 'label': s.label,
+        'scenario': s.scenario.get('name') if s.scenario else None,
+        'speed_kmh': None if s.speed is None else round(s.speed * 3.6, 6),
+        'duration_s': s.duration, 'sample_rate_hz': s.rate,
+        'excitation_hz': {m.label: [m.low, m.high] for m in marks_of(s)},
+    }
+    indices: dict[str, Any] = {}
+    if s.car_body:
+        cars: dict[str, Any] = {}
+        for car, series in s.car_body.items():
+            a, fs = series.values, series.rate
+            entry: dict[str, Any] = {'vertical_peak_m_s2': float(np.max(np.abs(a[:, 2]))),
+                                     'lateral_peak_m_s2': float(np.max(np.abs(a[:, 1]))),
+                                     'sperling_vertical': sperling_index(a[:, 2], fs),
+                                     'sperling_lateral': sperling_index(a[:, 1], fs, 'lateral'),
+                                     'wk_weighted_rms_m_s2': weighted_rms(a[:, 2], fs, 'Wk'),
+                                     'wd_weighted_rms_m_s2': weighted_rms(a[:, 1], fs, 'Wd')}
+            entry['vertical_psd_peak_hz'] = _body_peak(series)
+            entry['sperling_vertical_grade'] = sperling_grade(entry['sperling_vertical'])
+            cars[f'car{car:02d}'] = entry
+        out['car_body'] = cars
+        worst = max(cars, key=lambda c: cars[c]['sperling_vertical'])
+        indices['sperling_vertical'] = _index(cars[worst]['sperling_vertical'], SPERLING_LIMIT,
+                                              '-', worst)
+        worst_l = max(cars, key=lambda c: cars[c]['sperling_lateral'])
+        if cars[worst_l]['sperling_lateral'] > 0:
+            indices['sperling_lateral'] = _index(cars[worst_l]['sperling_lateral'],
+                                                 SPERLING_LIMIT, '-', worst_l)
+        for direction, key in (('vertical', 'vertical_peak_m_s2'),
+                               ('lateral', 'lateral_peak_m_s2')):
+            worst = max(cars, key=lambda c: cars[c][key])
+            if cars[worst][key] > 0:
+                indices[f'car_body_{direction}_acceleration'] = _index(
+                    cars[worst][key], CAR_BODY_LIMITS[direction], 'm/s^2', worst)
+    if s.wheel_rail:
+        out['wheel_rail'], wheel_indices = _wheel_rail_metrics(s)
+        indices.update(wheel_indices)
+    if s.midspan:
+        girders = {}
+        for span, series in s.midspan.items():
+            acc = deck_acceleration(series.values[:, 2], series.rate)
+            girders[f'span{span:02d}'] = {
+                'displacement_min_m': float(series.values[:, 2].min()),
+                'displacement_max_m': float(series.values[:, 2].max()),
+                'deck_acceleration_peak_m_s2': float(np.max(np.abs(acc)))}
+        out['girder'] = girders
+        worst = max(girders, key=lambda g: girders[g]['deck_acceleration_peak_m_s2'])
+        indices['deck_acceleration'] = _index(
+            girders[worst]['deck_acceleration_peak_m_s2'],
+            LIMITS['deck_acceleration_ballastless'], 'm/s^2', worst)
+    if s.bearing:
+        out['bearings'] = {f'pier{p:02d}_{side}': {'vertical_max_N': float(v.values[:, 2].max()),
+                                                   'vertical_min_N': float(v.values[:, 2].min())}
+                           for (p, side), v in s.bearing.items()}
+    if s.pile_acceleration or s.pile_displacement:
+        out['piles'] = _pile_metrics(s)
+    if s.soil is not None:
+        out['soil'] = _soil_metrics(s)
+    flows = power_flows(s)
+    if flows:
+        out['power_flow_mean_W_per_m'] = {
+            station: {layer: float(np.sum(p)) for layer, (_, p) in layers.items()}
+            for station, layers in flows.items()}
+    out['indices'] = indices
+    return out
+
+
+def _wheel_rail_metrics(s: Streams) -> tuple[dict[str, Any], dict[str, Any]]:
+    qp_max, qp_where = 0.0, ''
+    gb_max, dyn_max, red_where = 0.0, 0.0, ''
+    h_max, h_where, axle_loads = 0.0, '', []
+    fz_max = max(float(v.values[:, 2].max()) for v in s.wheel_rail.values())
+    fz_min = min(float(v.values[:, 2].min()) for v in s.wheel_rail.values())
+    for (car, axle, side), series in s.wheel_rail.items():
+        qp = derailment_coefficient(series.values[:, 1], series.values[:, 2])
+        if np.any(np.isfinite(qp)) and np.nanmax(qp) > qp_max:
+            qp_max, qp_where = float(np.nanmax(qp)), f'car{car:02d} axle{axle} {side}'
+        if side != 'left' or (car, axle, 'right') not in s.wheel_rail:
+            continue
+        right = s.wheel_rail[(car, axle, 'right')]
+        n = min(series.t.size, right.t.size)
+        gb, dyn = wheel_load_reduction(series.values[:n, 2], right.values[:n, 2])
+        if gb.max() > gb_max:
+            red_where = f'car{car:02d} axle{axle}'
+        gb_max, dyn_max = max(gb_max, float(gb.max())), max(dyn_max, float(dyn.max()))
+        h = np.abs(series.values[:n, 1] + right.values[:n, 1])
+        axle_loads.append(float(np.mean(series.values[:n, 2] + right.values[:n, 2])))
+        if h.max() > h_max:
+            h_max, h_where = float(h.max()), f'car{car:02d} axle{axle}'
+    metrics: dict[str, Any] = {'vertical_max_N': fz_max, 'vertical_min_N': fz_min,
+                               'derailment_coefficient_max': qp_max,
+                               'wheel_load_reduction_max': gb_max,
+                               'wheel_load_reduction_dynamic_max': dyn_max,
+                               'lateral_wheelset_force_max_N': h_max}
+    indices = {'derailment_coefficient': _index(qp_max, LIMITS['derailment_coefficient'], '-',
+                                                qp_where),
+               'wheel_load_reduction': _index(gb_max, LIMITS['wheel_load_reduction'], '-',
+                                              red_where)}
+    if axle_loads:
+        limit = lateral_force_limit(float(np.mean(axle_loads)))
+        metrics['lateral_wheelset_force_limit_N'] = limit
+        indices['lateral_wheelset_force'] = _index(h_max / 1e3, limit / 1e3, 'kN', h_where)
+    first = s.wheel_rail[min(s.wheel_rail)]
+    junction = next((m.low for m in marks_of(s) if m.label.startswith('V/')), None)
+    if junction and first.rate > 4.0 * junction and first.t.size / first.rate >= 2.0:
+        # as V19: 0.5 s Welch segments, the step searched within an octave of V / lambda
+        f, p = welch_psd(first.values[:, 2], first.rate, segment_seconds=0.5)
+        try:
+            metrics['vertical_psd_level_change_hz'] = level_change_frequency(
+                f, p, (0.5 * junction, 2.0 * junction))
+        except ValueError as exc:
+            log.info('no level change frequency of the wheel-rail PSD: %s', exc)
+    return metrics, indices
+
+
+def _pile_metrics(s: Streams) -> dict[str, Any]:
+    piles: dict[str, Any] = {}
+    for key in sorted(set(s.pile_acceleration) | set(s.pile_displacement)):
+        entry: dict[str, Any] = {}
+        if key in s.pile_acceleration:
+            entry['vertical_acceleration_peak_m_s2'] = float(
+                np.max(np.abs(s.pile_acceleration[key].values[:, 2])))
+            rate = s.pile_rotation_rate[key]
+            angle = np.cumsum(rate.values, axis=0) / rate.rate
+            entry['rotation_peak_rad'] = float(np.max(np.abs(angle[:, :2])))
+        if key in s.pile_displacement:
+            d = s.pile_displacement[key].values
+            entry['vertical_displacement_min_m'] = float(d[:, 2].min())
+            entry['horizontal_displacement_peak_m'] = float(np.max(np.hypot(d[:, 0], d[:, 1])))
+        piles[f'pier{key[0]:02d}_pile{key[1]:02d}'] = entry
+    return piles
+
+
+def _soil_xyz(s: Streams) -> np.ndarray | None:
+    if s.soil is None or not all(c in s.soil_fields for c in ('x', 'y', 'z', 'az')):
+        return None
+    return np.stack([s.soil.values[0, :, s.soil_fields.index(c)] for c in ('x', 'y', 'z')],
+                    axis=-1).astype(float)
+
+
+def soil_line(s: Streams) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
+    """
+    Return (point indices, distance along the line (m), az (n, points)) of the observation line.
+
+    The line is the points at the first point's y and z (to 1 mm), ordered by x:
+    ttb_sim writes [P]'s observation line first, then the VAL points and the
+    user's points elsewhere.
+    """
+    xyz = _soil_xyz(s)
+    if xyz is None or s.soil is None:
+        return None
+    on = np.flatnonzero((np.abs(xyz[:, 1] - xyz[0, 1]) < 1e-3)
+                        & (np.abs(xyz[:, 2] - xyz[0, 2]) < 1e-3))
+    order = on[np.argsort(xyz[on, 0], kind='stable')]
+    distance = xyz[order, 0] - xyz[order[0], 0]
+    return order, distance, s.soil.values[:, order, s.soil_fields.index('az')]
+
+
+def soil_val_points(s: Streams) -> list[tuple[str, np.ndarray]]:
+    """
+    Return (label, vertical acceleration record) of the ground points to rate by VAL.
+
+    The points off the observation line (ttb_sim's [P] section 4.2.2 VAL points and the
+    user's points) when there are any, else the first, middle and last point of the line.
+    """
+    xyz = _soil_xyz(s)
+    line = soil_line(s)
+    if xyz is None or line is None or s.soil is None:
+        return []
+    az = s.soil.values[:, :, s.soil_fields.index('az')]
+    off = [i for i in range(xyz.shape[0]) if i not in set(line[0].tolist())]
+    if off:
+        return [(f'point ({xyz[i, 0]:.1f}, {xyz[i, 1]:.1f}) m', az[:, i]) for i in off]
+    order, distance, _ = line
+    n = order.size
+    return [(f'line point at {distance[k]:.1f} m', az[:, order[k]])
+            for k in sorted({0, n // 2, n - 1})]
+
+
+def _soil_metrics(s: Streams) -> dict[str, Any]:
+    line = soil_line(s)
+    if line is None or s.soil is None:
+        return {}
+    fs = s.soil.rate
+    points = {}
+    for label, record in soil_val_points(s):
+        centres, val = vibration_levels(record, fs)
+        points[label.replace(' ', '_')] = {
+            'vertical_acceleration_peak_m_s2': float(np.max(np.abs(record))),
+            'val_band_centres_hz': [float(c) for c in centres],
+            'val_db': [float(v) if math.isfinite(v) else None for v in val],
+            'val_max_db': float(np.max(val)), 'val_max_band_hz': float(centres[np.argmax(val)]),
+            'vl_total_db': total_level(centres, val),
+            'vl_wk_db': total_level(centres, val, 'Wk'),
+            'vl_wm_db': total_level(centres, val, 'Wm')}
+    return {'line_peak_acceleration_m_s2': float(np.max(np.abs(line[2]))), 'points': points}
+
+
+# -- power flow --------------------------------------------------------------------------
+
+def observer_stations(s: Streams) -> dict[float, dict[str, Series]]:
+    """Return {x: {layer: displacement series}} of the bag's observers, from the scenario echo."""
+    specs = s.section('output').get('observers', []) if s.scenario else []
+    stations: dict[float, dict[str, Series]] = {}
+    for spec in specs if isinstance(specs, list) else []:
+        match = _OBSERVER.match(str(spec))
+        if not match or match.group(1) not in s.observers:
+            continue
+        name, component, x = match.group(1), match.group(2), float(match.group(3))
+        layer = 'rail' if component.startswith('rail') else component
+        stations.setdefault(x, {}).setdefault(layer, s.observers[name])
+    return stations
+
+
+def power_flows(s: Streams) -> dict[str, dict[str, tuple[np.ndarray, np.ndarray]]]:
+    """
+    Return the power flow spectra per observer station and layer (W per metre of track).
+
+    At a station where the rail, slab, base and girder displacements are all
+    observed, the interface forces per metre of track are those of the model's
+    connections (scenario echo): fasteners ``2 (k_f du + c_f dv) / spacing``
+    (two rails, both assumed to move as the observed one), and the slab-base
+    and base-girder layers ``k_l du + c_l dv``.  The power flow of a layer is
+    its interface force (Eq. 18) against its velocity: for the rail the force
+    of the fasteners below it (power it passes down), for slab, base and girder
+    the force of the connection above (power they receive).
+    """
+    track = s.section('track')
+    if track.get('model') != 'slab':
+        return {}
+    out: dict[str, dict[str, tuple[np.ndarray, np.ndarray]]] = {}
+    for x, layers in observer_stations(s).items():
+        if not all(k in layers for k in _LAYERS):
+            continue
+        n = min(layers[k].t.size for k in _LAYERS)
+        fs = layers['rail'].rate
+        u = {k: layers[k].values[:n, 2] for k in _LAYERS}
+        v = {k: velocity_from_displacement(u[k], fs) for k in _LAYERS}
+        kf = 2.0 * track['fastener_vertical_stiffness'] / track['fastener_spacing']
+        cf = 2.0 * track['fastener_vertical_damping'] / track['fastener_spacing']
+        kl, cl = track['layer_stiffness'], track['layer_damping']
+        q_fast = kf * (u['rail'] - u['slab']) + cf * (v['rail'] - v['slab'])
+        q_ca = kl * (u['slab'] - u['base']) + cl * (v['slab'] - v['base'])
+        q_bg = kl * (u['base'] - u['girder']) + cl * (v['base'] - v['girder'])
+        out[f'x={x:g} m'] = {
+            'rail': power_flow_spectrum(q_fast, v['rail'], fs),
+            'slab': power_flow_spectrum(q_fast, v['slab'], fs),
+            'base': power_flow_spectrum(q_ca, v['base'], fs),
+            'girder': power_flow_spectrum(q_bg, v['girder'], fs)}
+    return out

@@ -1,0 +1,111 @@
+# Copyright 2026 The ttb_sim Authors
+#
+# Licensed under the Apache License, Version 2.0 (the "License");
+# you may not use this file except in compliance with the License.
+# You may obtain a copy of the License at
+#
+#     http://www.apache.org/licenses/LICENSE-2.0
+#
+# Unless required by applicable law or agreed to in writing, software
+# distributed under the License is distributed on an "AS IS" BASIS,
+# WITHOUT WARRANTIES OR CONDITIONS OF ANY KIND, either express or implied.
+# See the License for the specific language governing permissions and
+# limitations under the License.
+
+"""
+Compiled kernels of the lean step (numba), each with a pure-numpy twin.
+
+A kernel is used only where a measurement showed it wins (README, Benchmark)
+and only when numba imports; otherwise the lean step takes the numpy twin,
+which computes the same numbers. The kernels are compiled on first use
+(about a second, cached on disk where the package directory is writable).
+"""
+
+from __future__ import annotations
+
+import logging
+from typing import Any, Callable
+
+import numpy as np
+
+log = logging.getLogger(__name__)
+
+ENABLED = True
+"""False makes :func:`compiled` return None, so the lean step takes the numpy twins."""
+_CACHE: dict[str, Callable[..., Any] | None] = {}
+
+
+def compiled(name: str) -> Callable[..., Any] | None:
+    """
+    Return the compiled kernel ``name`` (compiled on first call), or None.
+
+    None when numba is not installed or :data:`ENABLED` is False; numba is
+    imported only here, so the package imports without it and quickly.
+    """
+    if not ENABLED:
+        return None
+    if name not in _CACHE:
+        try:
+            import numba
+        except ImportError:  # pragma: no cover - depends on the installation
+            log.debug('numba is not installed; the lean step runs its numpy twins')
+            _CACHE[name] = None
+        else:
+            _CACHE[name] = numba.njit(cache=True, nogil=True)(_KERNELS[name])
+    return _CACHE[name]
+
+
+def _moving_load(positions: np.ndarray, forces: np.ndarray, h: float, n_el: int,
+                 length: float, dofs: np.ndarray, out: np.ndarray) -> None:
+    """
+    Sum the consistent load of vertical axle forces on the girder into ``out``.
+
+    The same arithmetic as :meth:`ttb_sim.sim.lean.MovingLoad._rows` followed
+    by ``np.bincount``, axle by axle.
+    """
+    out[:] = 0.0
+    for i in range(positions.shape[0]):
+        x = positions[i]
+        s = x / h
+        e = min(max(np.floor(s), 0.0), n_el - 1)
+        element = int(e)
+        xi = min(max(s - e, 0.0), 1.0)
+        if x >= 0.0 and x <= length:
+            weight = -forces[i]
+        else:
+            weight = 0.0
+        xi2 = xi * xi
+        xi3 = xi2 * xi
+        r0 = (1.0 - 3.0 * xi2 + 2.0 * xi3) * weight
+        r1 = ((xi3 - 2.0 * xi2 + xi) * -h) * weight
+        r2 = (3.0 * xi2 - 2.0 * xi3) * weight
+        r3 = ((xi3 - xi2) * -h) * weight
+        out[dofs[element, 0]] += r0
+        out[dofs[element, 1]] += r1
+        out[dofs[element, 2]] += r2
+        out[dofs[element, 3]] += r3
+
+
+def _history(u: np.ndarray, v: np.ndarray, a: np.ndarray, a0: float, a1: float,
+             h_v: np.ndarray, h_a: np.ndarray) -> None:
+    """Newmark history terms into h_v, h_a: the arithmetic of the lean numpy path."""
+    two_a1 = 2.0 * a1
+    for i in range(u.shape[0]):
+        h_v[i] = u[i] * -a1 - v[i]
+        h_a[i] = u[i] * -a0 - v[i] * two_a1 - a[i]
+
+
+def _finish(u: np.ndarray, a0: float, a1: float, h_v: np.ndarray,
+            h_a: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Return (a1 u + h_v, a0 u + h_a) as new vectors."""
+    n = u.shape[0]
+    v = np.empty(n)
+    a = np.empty(n)
+    for i in range(n):
+        v[i] = a1 * u[i] + h_v[i]
+        a[i] = a0 * u[i] + h_a[i]
+    return v, a
+
+
+_KERNELS: dict[str, Callable[..., Any]] = {
+    'moving_load': _moving_load, 'history': _history, 'finish': _finish}

@@ -1,0 +1,211 @@
+# Copyright 2026 The ttb_sim Authors
+#
+# Licensed under the Apache License, Version 2.0 (the "License");
+# you may not use this file except in compliance with the License.
+# You may obtain a copy of the License at
+#
+#     http://www.apache.org/licenses/LICENSE-2.0
+#
+# Unless required by applicable law or agreed to in writing, software
+# distributed under the License is distributed on an "AS IS" BASIS,
+# WITHOUT WARRANTIES OR CONDITIONS OF ANY KIND, either express or implied.
+# See the License for the specific language governing permissions and
+# limitations under the License.
+
+"""
+A pile-soil substructure alone under its head load, stepped to frames.
+
+:class:`SubstructureRun` is what ``ttb-sim run`` and the node step when a
+scenario's ``load.type`` is not 'none' (``single_pile``, ``pile_harmonic``):
+the group is ``pier01``, its piles and soil points fill the pile and soil
+fields of each :class:`~ttb_sim.sim.frames.Frame`. It offers the same run
+interface as :class:`~ttb_sim.sim.simulation.Simulation` (layout, dt, steps,
+frames, cost estimate), so the bag writer and the node need not know which
+model they step.
+
+Time step: ``solver.dt`` (0 = automatic, 1/40 of the load period) is the
+largest step wanted; with the explicit soil of the mixed scheme
+(:mod:`ttb_sim.sim.pile_soil`) the stable step caps it. The step is then
+shortened so that frames (``output.rate_hz``; 0 = one per wanted step) fall
+on steps. A static load gives one frame at t = 0 with the static solution.
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+from typing import Any, Iterator
+
+import numpy as np
+
+from ttb_sim.config import Scenario
+from ttb_sim.errors import DivergenceError, ScenarioError
+from ttb_sim.model.foundation.substructure import build, PileSoilModel, rayleigh_coefficients
+from ttb_sim.sim.cost import CostEstimate, STEP_BUDGET
+from ttb_sim.sim.frames import Frame, Layout
+from ttb_sim.sim.pile_soil import (choose_scheme, explicit_omega_max, initial_state, observe,
+                                   PartitionedNewmark, stable_time_step, State, static_solve)
+from ttb_sim.sim.variants import blas_threads
+
+__all__ = ['SubstructureRun', 'AUTO_STEPS_PER_PERIOD', 'AUTO_PERIODS']
+
+log = logging.getLogger(__name__)
+
+AUTO_STEPS_PER_PERIOD = 40
+"""Steps per load period of the automatic ``solver.dt``."""
+AUTO_PERIODS = 40
+"""Load periods of the automatic ``solver.duration`` (2 s at [P]'s 20 Hz)."""
+MICROSECONDS_PER_CELL_STEP = 1.0
+"""Estimated cost of one brick for one step (measured 0.63 us of CPU on pile_harmonic)."""
+MESSAGE_MS = 0.08
+"""Cost of writing one message to the bag (ms), as :mod:`ttb_sim.sim.cost`."""
+
+
+class SubstructureRun:
+    """
+    The pile-soil substructure of a scenario, built and ready to step.
+
+    Parameters
+    ----------
+    scenario : Scenario
+        A scenario whose ``load.type`` is not 'none'.
+    max_steps : float or None
+        Step budget (None: no budget but the hard limit); a plan above it is
+        refused before the model is built.
+
+    Raises
+    ------
+    ScenarioError
+        For a plan over the step budget.
+
+    """
+
+    def __init__(self, scenario: Scenario, max_steps: float | None = STEP_BUDGET) -> None:
+        if not scenario.substructure_only:
+            raise ScenarioError("load.type = 'none': the scenario is not a substructure run")
+        self.scenario = scenario
+        self.load = scenario.load
+        self.static = self.load.type == 'static'
+        solver = scenario.solver
+        frequency = self.load.frequency
+        if self.static:
+            self.duration = 0.0
+            wanted = 0.0
+        else:
+            self.duration = solver.duration or AUTO_PERIODS / frequency
+            wanted = solver.dt or 1.0 / (AUTO_STEPS_PER_PERIOD * frequency)
+            steps = self.duration / wanted
+            if max_steps is not None and not steps <= max_steps:
+                raise ScenarioError(
+                    f'solver.duration = {self.duration:.6g} s at a step of {wanted:.3g} s '
+                    f'plans {steps:.3g} time steps, over the budget of {max_steps:.3g}: '
+                    'raise solver.dt or shorten solver.duration, or pass --force')
+        self.model: PileSoilModel = build(scenario.substructure('pier01'), self.load)
+        self.force = self.model.load_vector(self.load)
+        model = self.model
+        self.layout = Layout(n_spans=0, n_supports=0, n_bodies=0,
+                             piles=((1, model.n_piles),),
+                             soil_points=len(model.soil_points.names), train=False)
+        self.scheme = choose_scheme(model, 'auto')
+        self.stable_step = math.inf
+        self.integrator: PartitionedNewmark | None = None
+        if self.static:
+            self.dt, self.n_steps, self.output_every = 0.0, 0, 1
+            return
+        if self.scheme == 'mixed':
+            zeta = np.array([layer.damping_ratio for layer in model.spec.soil.layers])
+            alpha, beta = rayleigh_coefficients(zeta, model.spec.rayleigh_frequencies)
+            self.stable_step = stable_time_step(explicit_omega_max(model), float(alpha.min()),
+                                                float(beta.max()))
+        # the largest step both wanted and stable, shortened so that frames fall on steps
+        largest = min(wanted, self.stable_step)
+        rate = scenario.output.rate_hz
+        period = 1.0 / rate if rate > 0 else wanted
+        self.output_every = max(1, math.ceil(period / largest - 1e-9))
+        dt = period / self.output_every
+        if rate <= 0:
+            self.output_every = 1
+        self.dt = dt
+        self.n_steps = max(1, math.ceil(self.duration / dt - 1e-9))
+        if max_steps is not None and self.n_steps > max_steps:
+            raise ScenarioError(
+                f'the soil needs steps of at most {self.stable_step:.3g} s (explicit '
+                f'stability): solver.duration = {self.duration:.6g} s plans {self.n_steps} '
+                f'steps, over the budget of {max_steps:.3g}; shorten solver.duration or '
+                'coarsen soil.mesh.h, or pass --force')
+        self.integrator = PartitionedNewmark(model, dt, self.scheme)
+        log.info('pile-soil: %s scheme, dt = %.4g s (stable %.4g s), %d steps, %d DOFs',
+                 self.scheme, dt, self.stable_step, self.n_steps, model.n_dofs)
+
+    @property
+    def n_free(self) -> int:
+        """Free DOFs of the substructure."""
+        return int(self.model.free.sum())
+
+    @property
+    def n_frames(self) -> int:
+        """Frames the run will write (the initial one included)."""
+        return 1 + self.n_steps // self.output_every
+
+    def describe(self) -> dict[str, Any]:
+        """Return the model's sizes and the stepping plan (for ``summary.json``)."""
+        return {'pile_soil': dict(self.model.summary), 'scheme': self.scheme,
+                'stable_step': None if math.isinf(self.stable_step) else self.stable_step,
+                'load': self.load.type}
+
+    def plan(self, messages_per_frame: int) -> CostEstimate:
+        """Return the cost estimate of the run (before it runs)."""
+        cells = len(self.model.mesh.cells)
+        per_step = MICROSECONDS_PER_CELL_STEP * cells / 1000.0
+        messages = self.n_frames * messages_per_frame
+        wall = 0.3 + (self.n_steps * per_step + messages * MESSAGE_MS) / 1000.0
+        if self.static:
+            wall += 2e-5 * self.n_free  # conjugate gradients, measured order of magnitude
+        return CostEstimate(steps=self.n_steps, dt=self.dt, duration=self.duration,
+                            free_dofs=self.n_free, cars=0, frames=self.n_frames,
+                            messages=messages, per_step_ms=per_step, wall_time=wall)
+
+    def frames(self) -> Iterator[Frame]:
+        """
+        Yield one frame at t = 0 and then every ``output_every`` steps.
+
+        Raises
+        ------
+        DivergenceError
+            When a displacement is not finite or exceeds
+            ``solver.divergence_limit`` (the frames before it were yielded).
+
+        """
+        # Vector operations of this size gain nothing from BLAS threads, which only spin
+        # (measured: static single_pile 3x faster with one thread on a loaded machine).
+        with blas_threads(1):
+            if self.static:
+                yield self._frame(0, static_solve(self.model, self.force))
+                return
+            assert self.integrator is not None
+            state = initial_state(self.model)
+            yield self._frame(0, state)
+            history = self.load.history
+            for step in range(1, self.n_steps + 1):
+                state = self.integrator.step(state, self.force * history(step * self.dt))
+                if step % self.output_every == 0:
+                    yield self._frame(step, state)
+
+    def _frame(self, step: int, state: State) -> Frame:
+        limit = self.scenario.solver.divergence_limit
+        largest = float(np.max(np.abs(state.u), initial=0.0))
+        if not largest <= limit:
+            raise DivergenceError(f'pile-soil displacement {largest:.3g} m at t = '
+                                  f'{state.time:.6g} s exceeds solver.divergence_limit = '
+                                  f'{limit:g} m')
+        obs = observe(self.model, state)
+        points = np.hstack([self.model.soil_points.positions, obs.soil_displacement,
+                            obs.soil_acceleration])
+        empty = np.zeros((0, 3))
+        return Frame(step=step, time=state.time, head_position=0.0, speed=0.0,
+                     midspan=empty, bearings=np.zeros((0, 2, 3)),
+                     body_acceleration=empty, body_angular_velocity=empty,
+                     wheel_rail=np.zeros((0, 1, 2, 3)), observers=empty,
+                     pile_displacement=obs.pile_displacement,
+                     pile_acceleration=obs.pile_acceleration,
+                     pile_rotation_rate=obs.pile_rotation_rate, soil_points=points)
