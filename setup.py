@@ -62,7 +62,7 @@ setup(
     entry_points={
         'console_scripts': [
             'ttb-sim = ttb_sim.cli:entry',
-            'simulator = ttb_sim.simulator_node:main',
+            'simulator = ttb_sim.simulator:main',
         ],
     },
 )

@@ -20,14 +20,31 @@ Examples::
     ros2 launch ttb_sim simulator.launch.py
     ros2 launch ttb_sim simulator.launch.py scenario:=sprung_mass_beam rviz:=true
     ros2 launch ttb_sim simulator.launch.py params_file:=/path/to/my.yaml
+
+``rviz:=true`` where rviz2 is not installed logs a warning and starts the node alone.
 """
 
-from launch import LaunchDescription
-from launch.actions import DeclareLaunchArgument
+from typing import Any
+
+from ament_index_python.packages import get_package_prefix, PackageNotFoundError
+from launch import LaunchContext, LaunchDescription
+from launch.actions import DeclareLaunchArgument, LogInfo, OpaqueFunction
 from launch.conditions import IfCondition
 from launch.substitutions import LaunchConfiguration, PathJoinSubstitution
 from launch_ros.actions import Node
 from launch_ros.substitutions import FindPackageShare
+
+
+def rviz_if_installed(context: LaunchContext, *args: Any) -> list[Any]:
+    """Return the RViz node, or a warning when the rviz2 package is not installed."""
+    try:
+        get_package_prefix('rviz2')
+    except PackageNotFoundError:
+        return [LogInfo(msg='rviz:=true, but rviz2 is not installed (apt install '
+                            'ros-jazzy-rviz2); starting without RViz')]
+    share = FindPackageShare('ttb_sim')
+    return [Node(package='rviz2', executable='rviz2', name='rviz2', output='screen',
+                 arguments=['-d', PathJoinSubstitution([share, 'config', 'ttb_sim.rviz'])])]
 
 
 def generate_launch_description() -> LaunchDescription:
@@ -39,7 +56,7 @@ def generate_launch_description() -> LaunchDescription:
                                                                'simulator.yaml']),
             description='ROS parameters file of the ttb_sim node (ros__parameters).'),
         DeclareLaunchArgument(
-            'scenario', default_value='moving_force_beam',
+            'scenario', default_value='live_train',
             description='Scenario: a YAML path or a built-in name (ttb-sim scenarios).'),
         DeclareLaunchArgument('rviz', default_value='false',
                               description='Start RViz with config/ttb_sim.rviz.'),
@@ -47,7 +64,6 @@ def generate_launch_description() -> LaunchDescription:
              emulate_tty=True,
              parameters=[LaunchConfiguration('params_file'),
                          {'scenario': LaunchConfiguration('scenario')}]),
-        Node(package='rviz2', executable='rviz2', name='rviz2', output='screen',
-             arguments=['-d', PathJoinSubstitution([share, 'config', 'ttb_sim.rviz'])],
-             condition=IfCondition(LaunchConfiguration('rviz'))),
+        OpaqueFunction(function=rviz_if_installed,
+                       condition=IfCondition(LaunchConfiguration('rviz'))),
     ])

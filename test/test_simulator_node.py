@@ -157,6 +157,35 @@ def test_integer_speed_accepted_and_odometry_follows(looping):
     assert speeds[-1] == pytest.approx(97.2, abs=0.05)
 
 
+@pytest.mark.parametrize('overrides, words', [
+    ({'train.speed_kmh': -5.0}, ['train.speed_kmh = -5', '(0, 10000]']),
+    ({'publish_rate_hz': -1.0}, ['publish_rate_hz = -1', '[0, 10000]']),
+    ({'loop': 'yes_please'}, ['loop', 'yes_please', 'true or false']),
+])
+def test_start_up_values_rclpy_would_refuse_name_the_parameter(overrides, words):
+    context = Context()
+    rclpy.init(context=context)
+    try:
+        with pytest.raises(ScenarioError) as info:
+            SimulatorNode(context=context, parameter_overrides=[
+                Parameter(k, value=v) for k, v in overrides.items()])
+        message = str(info.value)
+        assert '\n' not in message and all(w in message for w in words), message
+    finally:
+        rclpy.try_shutdown(context=context)
+
+
+def test_bag_destination_that_exists_names_bag_path(tmp_path):
+    context = Context()
+    rclpy.init(context=context)
+    try:
+        with pytest.raises(ScenarioError, match=r'choose another bag\.path'):
+            SimulatorNode(context=context, parameter_overrides=[
+                Parameter('bag.enabled', value=True), Parameter('bag.path', value=str(tmp_path))])
+    finally:
+        rclpy.try_shutdown(context=context)
+
+
 @pytest.mark.parametrize('value', [integer(-5), double(-5.0), double(0.0)])
 def test_invalid_speed_refused_with_reason(looping, value):
     result, _ = looping.set_parameter('train.speed_kmh', value)
@@ -205,7 +234,8 @@ def test_integer_start_up_speed_stored_as_double():
     try:
         p = h.node.get_parameter('train.speed_kmh')
         assert p.type_ == Parameter.Type.DOUBLE and p.value == 350.0
-        assert h.node.controller.sim.speed == pytest.approx(350 / 3.6)
+        controller = wait_for(lambda: h.node.controller)
+        assert controller.sim.speed == pytest.approx(350 / 3.6)
     finally:
         h.close()
 
@@ -222,11 +252,12 @@ def test_invalid_start_up_value_raises():
 
 
 def test_bag_holds_every_frame(tmp_path):
+    """The executor, the stepping thread and a sqlite3 bag: every frame recorded."""
     path = tmp_path / 'bag'
     h = Harness(scenario='moving_force_beam', real_time_factor=0.0, loop=False,
-                **{'bag.enabled': True, 'bag.path': str(path)})
+                **{'bag.enabled': True, 'bag.path': str(path), 'bag.storage': 'sqlite3'})
     try:
-        wait_for(lambda: h.node.controller.state == 'idle')
+        wait_for(lambda: h.node.controller is not None and h.node.controller.state == 'idle')
         frames = h.node.controller.recorded
         layout = h.node.controller.layout
     finally:

@@ -17,33 +17,49 @@ The ROS 2 simulator node ``ttb_sim`` (``ros2 run ttb_sim simulator``).
 
 A thin rclpy shell over the ROS-free :mod:`ttb_sim.node`: it declares the parameters
 of :func:`~ttb_sim.node.parameters.parameter_table`, forwards parameter changes and
-service calls to a :class:`~ttb_sim.node.passage.PassageController`, and copies
-the controller's frames, diagnostics and markers into standard messages.
+service calls to a :class:`~ttb_sim.node.stepper.Stepper`, and copies frames,
+diagnostics and markers into standard messages.
+
+Threads:
+
+- the executor (a :class:`rclpy.executors.MultiThreadedExecutor`) answers
+  parameters and services and runs the 1 Hz diagnostics and the 10 Hz paused-clock
+  timers; it is never blocked by the model;
+- the stepping thread (:class:`~ttb_sim.node.stepper.Stepper`) builds the model
+  (``/diagnostics`` says "building model" meanwhile), opens the bag, steps paced by
+  ``real_time_factor``, writes every frame to the bag and closes it: the bag lives
+  on this one thread (SQLite requires it);
+- the publishing thread (:class:`~ttb_sim.node.publishing.PublishLoop`) turns the
+  frames due at ``publish_rate_hz`` into messages, within 20 % of the wall clock,
+  dropping (and counting) frames it cannot keep up with instead of slowing the
+  stepping.
 
 Publishers and their QoS (all explicit):
 
 - the topic table (:func:`ttb_sim.io.topics.topic_table`), private topics
-  ``~/...``: reliable, volatile, keep last 10 (QoS class 'sensor');
+  ``~/...``: reliable, volatile, keep last 10 (QoS class 'sensor'); created once
+  the model is built (its sizes come from the model);
 - ``/clock`` (when ``publish_clock``): reliable, volatile, keep last 1, so that
   both best-effort (rclcpp/rclpy time sources) and reliable subscribers match;
+  it never goes backwards, and while paused or idle it repeats the current time;
 - ``/diagnostics``: reliable, volatile, keep last 10, at 1 Hz (wall clock);
 - ``~/model/markers``: reliable, transient local, keep last 1 (latched: a late
   RViz gets the structure and the latest train position).
 
-Stepping runs in a steady-clock timer of its own callback group under a
-:class:`rclpy.executors.MultiThreadedExecutor`, so parameter and service calls
-(default callback group) are answered while the model steps; each tick steps
-for at most 20 ms. Timers use the steady clock, so ``use_sim_time`` (driven by
-this node's own /clock) cannot stall them. The bag is closed in ``main``'s
-``finally`` on shutdown, SIGINT and SIGTERM.
+Timers use the steady clock, so ``use_sim_time`` (driven by this node's own
+/clock) cannot stall them. On shutdown, SIGINT and SIGTERM the publishing stops
+first, then the stepping thread closes the bag; start-up errors (scenario,
+parameter values and types, bag destination) are one FATAL line and exit code 2.
 """
 
 from __future__ import annotations
 
 import functools
+import logging
 from pathlib import Path
 import sys
-from typing import Any
+import threading
+from typing import Any, Sequence
 
 from builtin_interfaces.msg import Time
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
@@ -53,26 +69,36 @@ from rcl_interfaces.msg import (FloatingPointRange, IntegerRange, ParameterDescr
 import rclpy
 from rclpy.callback_groups import MutuallyExclusiveCallbackGroup
 from rclpy.clock import Clock, ClockType
+from rclpy.exceptions import ParameterException
 from rclpy.executors import ExternalShutdownException, MultiThreadedExecutor
 from rclpy.logging import get_logger
 from rclpy.node import Node
 from rclpy.parameter import Parameter
 from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
+from rclpy.task import Future
+from rosgraph_msgs.msg import Clock as ClockMsg
 from rosidl_runtime_py.utilities import get_message
 from std_msgs.msg import ColorRGBA, Header
 from std_srvs.srv import SetBool, Trigger
 from ttb_sim.config import load_scenario
 from ttb_sim.errors import ModelError, ScenarioError
-from ttb_sim.io.bag import BagRecorder, default_bag_path
-from ttb_sim.io.topics import FRAME_ID, topic_table
+from ttb_sim.io.bag import BagRecorder, check_destination, default_bag_path, make_parents
+from ttb_sim.io.topics import FRAME_ID, Topic, topic_table
 from ttb_sim.node import (DEFAULT_SCENARIO, initial_values, markers, MarkerSet, NodeParameter,
-                          parameter_table, PassageController, validate_changes)
+                          parameter_table, PassageController, validate_changes,
+                          validate_parameter)
+from ttb_sim.node.passage import FrameSink, Tick
+from ttb_sim.node.publishing import PublishLoop
+from ttb_sim.node.stepper import Stepper
+from ttb_sim.sim.frames import Frame, Layout
 from visualization_msgs.msg import Marker, MarkerArray
 
-STEP_PERIOD = 0.01
-"""Stepping timer period (s, wall clock)."""
 STEP_BUDGET = 0.02
-"""Wall-clock seconds one stepping tick may spend (keeps calls answered within 100 ms)."""
+"""Wall-clock seconds one stepping tick may spend before it hands its frames on."""
+PUBLISH_DUTY = 0.2
+"""Largest share of the wall clock the publishing thread may take."""
+PAUSED_CLOCK_PERIOD = 0.1
+"""Wall-clock seconds between two /clock messages while paused or idle."""
 
 QOS = {
     'sensor': QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=10,
@@ -92,6 +118,26 @@ _PARAM_TYPES = {'bool': ParameterType.PARAMETER_BOOL,
                 'integer': ParameterType.PARAMETER_INTEGER,
                 'double': ParameterType.PARAMETER_DOUBLE,
                 'string': ParameterType.PARAMETER_STRING}
+
+
+class OnceFilter(logging.Filter):
+    """Let each distinct log message through once (a model warning, not once per passage)."""
+
+    def __init__(self) -> None:
+        super().__init__()
+        self._seen: set[str] = set()
+
+    def filter(self, record: logging.LogRecord) -> bool:  # noqa: A003 - logging API
+        """Return True the first time a message is seen."""
+        message = record.getMessage()
+        if message in self._seen:
+            return False
+        self._seen.add(message)
+        return True
+
+
+ONCE_LOGGERS = ('ttb_sim.sim.simulation',)
+"""Loggers of the model whose warnings repeat with every passage (each builds the model)."""
 
 
 @functools.lru_cache(maxsize=None)
@@ -137,6 +183,11 @@ class SimulatorNode(Node):
     """
     The ``ttb_sim`` node.
 
+    The constructor validates everything a user gives at start-up (scenario,
+    parameter values and types, bag destination) and returns at once; the model
+    is built on the stepping thread. :attr:`fatal` completes with ``(message,
+    exit code)`` if that build fails (or stepping ends on an unexpected error).
+
     Parameters
     ----------
     kwargs
@@ -145,86 +196,149 @@ class SimulatorNode(Node):
     Raises
     ------
     ScenarioError
-        If the scenario or a start-up parameter is invalid, or the bag cannot be
-        created (the node is destroyed first).
+        If the scenario, a start-up parameter or the bag destination is invalid
+        (the node is destroyed first).
 
     """
 
     def __init__(self, **kwargs: Any) -> None:
         super().__init__('ttb_sim', **kwargs)
-        self.controller: PassageController | None = None
+        self.stepper: Stepper | None = None
+        self.publish_loop: PublishLoop | None = None
+        self.topics: list[Topic] = []
+        self.publishers_by_name: dict[str, Any] = {}
+        self.fatal = Future()
+        self._fatal: tuple[str, int] = ('', 0)
+        self._clock_lock = threading.Lock()
+        self._last_clock = -1
+        self._last_build_log = 0.0
+        self._closed = False
         try:
             self._configure()
-        except (ScenarioError, ModelError):
+        except BaseException:   # a bad value, or Ctrl-C in the middle of the set-up
             self.close()
             self.destroy_node()
             raise
 
     @property
-    def _controller(self) -> PassageController:
-        """The passage controller; set by the constructor (callbacks run only after it)."""
-        if self.controller is None:
-            raise RuntimeError('the ttb_sim node is not configured')
-        return self.controller
+    def controller(self) -> PassageController | None:
+        """The passage controller, once the model is built (None before)."""
+        return self.stepper.controller if self.stepper is not None else None
 
     # -- set-up -------------------------------------------------------------------------
 
+    def _declare(self, name: str, default: Any, param: NodeParameter) -> Any:
+        """Declare one parameter; a value rclpy refuses becomes a ScenarioError."""
+        override = getattr(self, '_parameter_overrides', {}).get(name)
+        if override is not None:
+            ok, reason = validate_parameter(param, override.value, initial=True)
+            if not ok:
+                raise ScenarioError(reason)
+        try:
+            return self.declare_parameter(name, default, descriptor(param)).value
+        except ParameterException as exc:
+            raise ScenarioError(f'{name}: {" ".join(str(exc).split())} (allowed '
+                                f'{param.allowed()})') from None
+
     def _configure(self) -> None:
-        table = parameter_table()
-        first = table['scenario']
-        source = self.declare_parameter('scenario', DEFAULT_SCENARIO,
-                                        descriptor(first)).value
+        for name in ONCE_LOGGERS:
+            logger = logging.getLogger(name)
+            if not any(isinstance(f, OnceFilter) for f in logger.filters):
+                logger.addFilter(OnceFilter())
+        first = parameter_table()['scenario']
+        source = self._declare('scenario', DEFAULT_SCENARIO, first)
         scenario = load_scenario(source)
+        self.scenario = scenario
         self.table = parameter_table(scenario)
         given: dict[str, Any] = {'scenario': source}
         for name, param in self.table.items():
             if name != 'scenario':
-                given[name] = self.declare_parameter(name, param.default,
-                                                     descriptor(param)).value
+                given[name] = self._declare(name, param.default, param)
         values = initial_values(self.table, given)
+        self.values = values
         # Start-up integers for double parameters: store them as doubles, too.
         retype = [Parameter(n, Parameter.Type.DOUBLE, values[n]) for n, p in self.table.items()
                   if p.kind == 'double' and not isinstance(given[n], float)]
         if retype:
             self.set_parameters(retype)
 
-        self._types = message_class
-        namespace = self.get_fully_qualified_name()
-        self.controller = PassageController(scenario, values)
-        self.topics = topic_table(self.controller.layout)
+        self.namespace = self.get_fully_qualified_name()
+        open_recorder = None
         if values['bag.enabled']:
             path = Path(values['bag.path']) if values['bag.path'] else \
                 default_bag_path(scenario.name)
-            path.parent.mkdir(parents=True, exist_ok=True)
-            # Nothing has been stepped yet, so the bag gets every frame from t = 0.
-            self.controller.recorder = BagRecorder(path, self.topics, values['bag.storage'],
-                                                   namespace=namespace).__enter__()
-            self.get_logger().info(f'recording to {path} ({values["bag.storage"]})')
-        self.publishers_by_name = {}
-        for topic in self.topics:
-            name = topic.name if topic.name.startswith('/') else f'~/{topic.name}'
-            self.publishers_by_name[topic.name] = self.create_publisher(
-                message_class(topic.msgtype), name, QOS[topic.qos])
+            check_destination(path, values['bag.storage'], option='bag.path')
+            open_recorder = functools.partial(self._open_recorder, path, values['bag.storage'])
+
+        self.clock_pub = self.create_publisher(ClockMsg, '/clock', QOS['clock'])
         self.diagnostics_pub = self.create_publisher(DiagnosticArray, '/diagnostics',
                                                      DIAGNOSTICS_QOS)
         self.markers_pub = self.create_publisher(MarkerArray, '~/model/markers',
                                                  QOS['latched'])
         self.create_service(Trigger, '~/reset', self._on_reset)
         self.create_service(SetBool, '~/pause', self._on_pause)
-
         steady = Clock(clock_type=ClockType.STEADY_TIME)
-        self.step_timer = self.create_timer(STEP_PERIOD, self._on_step,
-                                            callback_group=MutuallyExclusiveCallbackGroup(),
-                                            clock=steady)
         self.diagnostics_timer = self.create_timer(1.0, self._on_diagnostics, clock=steady)
-
+        self.paused_clock_timer = self.create_timer(
+            PAUSED_CLOCK_PERIOD, self._on_paused_clock,
+            callback_group=MutuallyExclusiveCallbackGroup(), clock=steady)
+        self._built_guard = self.create_guard_condition(self._on_built)
+        self._failed_guard = self.create_guard_condition(self._on_failed)
         self.add_pre_set_parameters_callback(self._pre_set)
         self.add_on_set_parameters_callback(self._on_set)
         self.add_post_set_parameters_callback(self._post_set)
         self._publish_markers(scenario.train.start_position)
+
+        self.stepper = Stepper(scenario, values, on_tick=self._on_tick,
+                               open_recorder=open_recorder,
+                               on_built=lambda _c: self._built_guard.trigger(),
+                               on_failed=self._stepper_failed, budget=STEP_BUDGET)
+        self.stepper.start()
+        self.get_logger().info(f'scenario {scenario.name!r}: building model '
+                               '(see /diagnostics)')
+
+    def _open_recorder(self, path: Path, storage: str, layout: Layout) -> FrameSink:
+        """Open the bag (on the stepping thread, which also writes and closes it)."""
+        make_parents(path)
+        recorder = BagRecorder(path, topic_table(layout), storage,
+                               namespace=self.namespace).__enter__()
+        self._log('info', f'recording to {path} ({storage})')
+        return recorder
+
+    def _log(self, level: str, message: str) -> None:
+        """Log through rclpy while the context is valid (never after shutdown: no rosout)."""
+        if self.context.ok() and not self._closed:
+            getattr(self.get_logger(), level)(message)
+
+    def _stepper_failed(self, message: str, code: int) -> None:
+        """Hand a build failure to the executor (runs on the stepping thread)."""
+        self._fatal = (message, code)
+        self._failed_guard.trigger()
+
+    def _on_failed(self) -> None:
+        if not self.fatal.done():
+            self.fatal.set_result(self._fatal)
+
+    def _on_built(self) -> None:
+        """Create the topic-table publishers (on the executor) and start publishing."""
+        controller = self.controller
+        if controller is None or self.publish_loop is not None or self._closed:
+            return
+        self.topics = topic_table(controller.layout)
+        for topic in self.topics:
+            if topic.qos == 'clock':
+                continue
+            name = topic.name if topic.name.startswith('/') else f'~/{topic.name}'
+            self.publishers_by_name[topic.name] = self.create_publisher(
+                message_class(topic.msgtype), name, QOS[topic.qos])
+        self.publish_loop = PublishLoop(self._publish_frames, duty=PUBLISH_DUTY)
+        self.publish_loop.start()
+        assert self.stepper is not None
+        self.stepper.publishing_ready()
+        status = self.stepper.status()
         self.get_logger().info(
-            f'scenario {scenario.name!r}: {self.controller.sim.dt:.3g} s steps, '
-            f'{len(self.topics)} topics under {namespace}/')
+            f'model built in {status.elapsed:.2f} s: {controller.sim.dt:.3g} s steps, '
+            f'{len(self.topics)} topics under {self.namespace}/; publishing')
 
     # -- parameters ---------------------------------------------------------------------
 
@@ -241,71 +355,154 @@ class SimulatorNode(Node):
 
     def _on_set(self, parameters: list[Parameter]) -> SetParametersResult:
         """Validate proposed values; a refusal changes nothing and names the range."""
-        ok, reason = validate_changes(self.table, {p.name: p.value for p in parameters})
+        known = {p.name: p.value for p in parameters if p.name in self.table}
+        ok, reason = validate_changes(self.table, known)
         return SetParametersResult(successful=ok, reason=reason)
 
     def _post_set(self, parameters: list[Parameter]) -> None:
-        """Apply accepted values to the running simulation."""
+        """Apply accepted values to the running simulation (or the one being built)."""
         for p in parameters:
-            self._controller.apply(p.name, p.value)
-            self.get_logger().info(f'{p.name} = {p.value!r}')
+            if p.name in self.table and self.stepper is not None:
+                self.stepper.apply(p.name, p.value)
+                self.values[p.name] = p.value
+                self.get_logger().info(f'{p.name} = {p.value!r}')
 
     # -- services -----------------------------------------------------------------------
 
+    def _building(self) -> str:
+        assert self.stepper is not None
+        status = self.stepper.status()
+        if status.state == 'failed':
+            return f'the model could not be built: {status.error}'
+        return f'the model is still being built ({status.elapsed:.1f} s so far); try again'
+
     def _on_reset(self, request: Trigger.Request,
                   response: Trigger.Response) -> Trigger.Response:
-        response.message = self._controller.reset()
+        controller = self.controller
+        if controller is None:
+            response.success, response.message = False, self._building()
+            return response
+        response.message = controller.reset()
         response.success = True
+        self._wake_stepper()
         return response
 
     def _on_pause(self, request: SetBool.Request,
                   response: SetBool.Response) -> SetBool.Response:
-        response.message = self._controller.set_paused(bool(request.data))
-        response.success = self._controller.state in ('paused', 'running')
+        controller = self.controller
+        if controller is None:
+            response.success, response.message = False, self._building()
+            return response
+        response.message = controller.set_paused(bool(request.data))
+        response.success = controller.state in ('paused', 'running')
+        self._wake_stepper()
         return response
+
+    def _wake_stepper(self) -> None:
+        if self.stepper is not None:
+            self.stepper.wake()
 
     # -- stepping and publishing --------------------------------------------------------
 
-    def _on_step(self) -> None:
-        tick = self._controller.advance(budget=STEP_BUDGET)
-        if 'diverged' in tick.events:
-            self.get_logger().error(f'{self._controller.divergence}; stepping stopped, bag '
-                                    'closed; call ~/reset to restart')
+    def _on_tick(self, tick: Tick) -> None:
+        """Log passage events and hand the frames to the publisher (stepping thread)."""
+        if 'diverged' in tick.events and self.controller is not None:
+            self._log('error', f'{self.controller.divergence}; stepping stopped, bag closed; '
+                      'call ~/reset to restart')
         if 'idle' in tick.events:
-            self.get_logger().info('the train has left: idle (set loop:=true or call '
-                                   '~/reset for another passage)')
-        if not tick.frames or not self.context.ok():
+            self._log('info', 'the train has left: idle (set loop:=true or call ~/reset for '
+                      'another passage)')
+        if self.publish_loop is not None:
+            self.publish_loop.offer(tick.frames, tick.markers)
+
+    def _publish_frames(self, frames: Sequence[Frame], refresh_markers: bool) -> None:
+        """Send each frame's messages in order (publishing thread)."""
+        if not frames and not refresh_markers:
             return
-        clock = self._controller.values['publish_clock']
         try:
-            for frame in tick.frames:
+            clock = bool(self.values['publish_clock'])
+            for frame in frames:
+                if not self.context.ok():
+                    return
+                if clock:
+                    self._publish_clock(frame.stamp_ns)
                 for topic in self.topics:
-                    if topic.qos == 'clock' and not clock:
-                        continue
-                    self.publishers_by_name[topic.name].publish(
-                        topic.message(self._types, frame))
-            if tick.markers:
-                self._publish_markers(tick.frames[-1].head_position)
+                    if topic.qos != 'clock':
+                        self.publishers_by_name[topic.name].publish(
+                            topic.message(message_class, frame))
+            if refresh_markers and frames:
+                self._publish_markers(frames[-1].head_position)
         except Exception as exc:  # noqa: B902 - shutting down under our feet
-            if self.context.ok():
+            if self.context.ok() and not self._closed:
                 raise
-            self.get_logger().debug(f'publishing stopped at shutdown: {exc}')
+            self._log('debug', f'publishing stopped at shutdown: {exc}')
+
+    def _publish_clock(self, stamp_ns: int) -> None:
+        """Publish /clock unless that would go back in time (from any thread)."""
+        with self._clock_lock:
+            if stamp_ns < self._last_clock:
+                return
+            self._last_clock = stamp_ns
+            sec, nanosec = divmod(int(stamp_ns), 1_000_000_000)
+            self.clock_pub.publish(ClockMsg(clock=Time(sec=sec, nanosec=nanosec)))
+
+    def _on_paused_clock(self) -> None:
+        """While paused, idle or diverged, keep /clock at the current simulation time."""
+        controller = self.controller
+        if (controller is None or controller.state == 'running'
+                or not self.values['publish_clock'] or self._closed):
+            return
+        self._publish_clock(round(controller.node_time * 1e9))
 
     def _publish_markers(self, head_position: float) -> None:
-        self.markers_pub.publish(marker_array(markers(self._controller.base, head_position)))
+        self.markers_pub.publish(marker_array(markers(self.scenario, head_position)))
 
     def _on_diagnostics(self) -> None:
-        report = self._controller.diagnostics()
-        status = DiagnosticStatus(level=bytes([report.level]), name='ttb_sim: simulation',
-                                  message=report.message, hardware_id=self.get_name(),
-                                  values=[KeyValue(key=k, value=v) for k, v in report.values])
+        if self.stepper is None:
+            return
+        controller = self.controller
+        status = self.stepper.status()
+        if controller is None:
+            if status.state == 'failed':
+                level, message = 2, f'cannot build the model: {status.error}'
+            else:
+                level, message = 0, f'building model: {status.elapsed:.1f} s'
+                if status.elapsed - self._last_build_log >= 2.0:
+                    self._last_build_log = status.elapsed
+                    self.get_logger().info(f'building model {self.scenario.name!r}: '
+                                           f'{status.elapsed:.1f} s so far')
+            values = [('state', status.state), ('scenario', self.scenario.name),
+                      ('build time so far (s)', f'{status.elapsed:.1f}')]
+        else:
+            report = controller.diagnostics()
+            level, message = report.level, report.message
+            values = list(report.values)
+            values.append(('model build time (s)', f'{status.elapsed:.2f}'))
+            if status.state == 'failed':
+                level, message = 2, status.error
+            if self.publish_loop is not None:
+                stats = self.publish_loop.stats()
+                values += [('published frames', str(stats.published)),
+                           ('dropped frames (publishing could not keep up)',
+                            str(stats.dropped)),
+                           ('publish time per frame (ms)', f'{stats.ms_per_frame:.3f}')]
+                if self.publish_loop.error:
+                    level, message = 2, self.publish_loop.error
+        diag = DiagnosticStatus(level=bytes([level]), name='ttb_sim: simulation',
+                                message=message, hardware_id=self.get_name(),
+                                values=[KeyValue(key=k, value=v) for k, v in values])
         header = Header(stamp=self.get_clock().now().to_msg(), frame_id='')
-        self.diagnostics_pub.publish(DiagnosticArray(header=header, status=[status]))
+        self.diagnostics_pub.publish(DiagnosticArray(header=header, status=[diag]))
 
     def close(self) -> None:
-        """Stop stepping and close the bag (idempotent; called before destroy_node)."""
-        if self.controller is not None:
-            self.controller.close()
+        """Stop publishing, then stepping; the bag is closed on the stepping thread."""
+        self._closed = True   # from here on nothing is published or logged through rclpy
+        if self.publish_loop is not None:
+            self.publish_loop.stop()
+        building = self.stepper is not None and self.stepper.status().state == 'building'
+        if self.stepper is not None and not self.stepper.stop(timeout=1.0 if building else 10.0):
+            self._log('warning', 'the model is still being built; leaving it behind (no bag '
+                      'was open yet)')
 
 
 def marker_array(marker_set: MarkerSet) -> MarkerArray:
@@ -338,9 +535,17 @@ def marker_array(marker_set: MarkerSet) -> MarkerArray:
     return MarkerArray(markers=out)
 
 
+def _shutting_down(context: Any = None) -> bool:
+    """Tell whether rclpy is shutting down (the context is no longer valid)."""
+    try:
+        return not rclpy.ok(context=context)
+    except Exception:  # noqa: B902 - no context at all: shutting down
+        return True
+
+
 def main(args: list[str] | None = None) -> int:
     """
-    Run the node until shutdown, Ctrl-C or SIGTERM (the Jazzy pattern).
+    Run the node until shutdown, Ctrl-C or SIGTERM.
 
     Parameters
     ----------
@@ -350,28 +555,54 @@ def main(args: list[str] | None = None) -> int:
     Returns
     -------
     int
-        0 on a normal or signalled end, 2 on an invalid scenario or parameter.
+        0 on a normal or signalled end, 2 on an invalid scenario, parameter or bag
+        destination, or a model that cannot be built (one FATAL line).
 
     """
-    rclpy.init(args=args)
-    node = None
+    logger = get_logger('ttb_sim')
+    try:
+        rclpy.init(args=args)
+    except KeyboardInterrupt:
+        return 0
+    node: SimulatorNode | None = None
+    executor: MultiThreadedExecutor | None = None
     code = 0
     try:
         node = SimulatorNode()
         executor = MultiThreadedExecutor()
         executor.add_node(node)
-        executor.spin()
+        executor.spin_until_future_complete(node.fatal)
+        if node.fatal.done():
+            message, code = node.fatal.result()
+            logger.fatal(message)
     except (KeyboardInterrupt, ExternalShutdownException):
         pass
     except (ScenarioError, ModelError) as exc:
-        get_logger('ttb_sim').fatal(str(exc))
+        logger.fatal(str(exc))
         code = 2
+    except Exception as exc:  # noqa: B902 - the rclpy shutdown race (RCLError, InvalidHandle)
+        if not _shutting_down():
+            logger.fatal(f'{type(exc).__name__}: {exc}')
+            code = 1
     finally:
-        if node is not None:
-            node.close()
-            node.destroy_node()
-        rclpy.try_shutdown()
+        _finish(node, executor)
     return code
+
+
+def _finish(node: SimulatorNode | None, executor: MultiThreadedExecutor | None) -> None:
+    """Close the bag, destroy the node and shut rclpy down; a second Ctrl-C changes nothing."""
+    for step in ('close', 'executor', 'destroy', 'shutdown'):
+        try:
+            if step == 'close' and node is not None:
+                node.close()
+            elif step == 'executor' and executor is not None:
+                executor.shutdown(timeout_sec=1.0)
+            elif step == 'destroy' and node is not None:
+                node.destroy_node()
+            elif step == 'shutdown':
+                rclpy.try_shutdown()
+        except (KeyboardInterrupt, Exception):  # noqa: B902 - never a traceback at exit
+            pass
 
 
 if __name__ == '__main__':

@@ -29,8 +29,8 @@ from ttb_sim.cli import main
 from ttb_sim.config import builtin_scenarios, load_scenario
 from ttb_sim.errors import ScenarioError
 
-SHIPPED = ('moving_force_beam', 'sprung_mass_beam', 'ten_span_train', 'track_approach',
-           'paper_ttbi')
+SHIPPED = ('live_train', 'moving_force_beam', 'sprung_mass_beam', 'ten_span_train',
+           'track_approach', 'paper_ttbi')
 
 
 def test_the_shipped_list_is_complete():

@@ -36,7 +36,7 @@ STORAGES = {'mcap': StoragePlugin.MCAP, 'sqlite3': StoragePlugin.SQLITE3}
 """Storage back-ends by their rosbag2 plugin names."""
 
 
-def check_destination(path: str | Path, storage: str) -> None:
+def check_destination(path: str | Path, storage: str, option: str = '--out') -> None:
     """
     Refuse a bag destination that cannot be created, before anything is built or written.
 
@@ -44,6 +44,16 @@ def check_destination(path: str | Path, storage: str) -> None:
     existing ancestor must be a directory (not a file, which the path would be
     inside) that this process may write into, so that the missing parents and
     the bag directory can be made.
+
+    Parameters
+    ----------
+    path : path-like
+        The bag directory to create.
+    storage : str
+        The storage plugin name.
+    option : str
+        How the user gave the destination (``--out``, or the node's ``bag.path``),
+        named in the messages.
 
     Raises
     ------
@@ -58,7 +68,7 @@ def check_destination(path: str | Path, storage: str) -> None:
     name = shown(str(path))
     if out.exists() or out.is_symlink():
         raise ScenarioError(f'output directory {name} exists; refusing to overwrite it '
-                            '(choose another --out)')
+                            f'(choose another {option})')
     try:
         absolute = Path(os.path.abspath(out))
     except (OSError, ValueError) as exc:

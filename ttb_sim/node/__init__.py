@@ -23,6 +23,10 @@ copies values into and out of rclpy objects.
   scenario of a passage;
 - :mod:`~ttb_sim.node.passage`: the :class:`PassageController` that steps,
   paces, records and reports passages (ticks, frame sink, diagnostics);
+- :mod:`~ttb_sim.node.stepper`: the stepping thread (:class:`Stepper`) that builds
+  the model, opens, writes and closes the bag and steps, off the executor;
+- :mod:`~ttb_sim.node.publishing`: the publishing thread (:class:`PublishLoop`)
+  that sends frames within a share of the wall clock, dropping what it cannot send;
 - :mod:`~ttb_sim.node.markers`: the structure and train markers as plain boxes.
 """
 
@@ -33,6 +37,8 @@ from ttb_sim.node.parameters import (DEFAULT_SCENARIO, initial_values, IRREGULAR
                                      validate_parameter)
 from ttb_sim.node.passage import (DiagnosticsReport, ERROR, frame_values, FrameSink, OK,
                                   PassageController, Tick, WARN)
+from ttb_sim.node.publishing import PublishLoop, PublishStats
+from ttb_sim.node.stepper import Stepper, StepperStatus
 
 __all__ = [
     'Box',
@@ -51,8 +57,12 @@ __all__ = [
     'OK',
     'parameter_table',
     'PassageController',
+    'PublishLoop',
+    'PublishStats',
     'SCENARIO_KEYS',
     'scenario_with',
+    'Stepper',
+    'StepperStatus',
     'Tick',
     'train_markers',
     'validate_changes',

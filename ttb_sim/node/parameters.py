@@ -44,7 +44,7 @@ from ttb_sim.errors import ScenarioError
 from ttb_sim.inputs import shown
 from ttb_sim.io.bag import STORAGES
 
-DEFAULT_SCENARIO = 'moving_force_beam'
+DEFAULT_SCENARIO = 'live_train'
 """Scenario loaded when the ``scenario`` parameter is not given."""
 
 SCENARIO_KEYS = ('train.speed_kmh', 'irregularity.spectrum', 'irregularity.seed',
@@ -129,7 +129,7 @@ _NODE_ONLY: dict[str, tuple[str, Any, Spec, bool]] = {
     'real_time_factor': ('double', 1.0, Spec(
         '-', 'Simulated seconds per wall-clock second; 0 = as fast as possible.',
         low=0.0, high=1000.0), False),
-    'loop': ('bool', False, Spec(
+    'loop': ('bool', True, Spec(
         '-', 'Start a new passage when the train has left (otherwise the node idles).'),
         False),
     'publish_clock': ('bool', True, Spec(

@@ -1,0 +1,106 @@
+# Copyright 2026 The ttb_sim Authors
+#
+# Licensed under the Apache License, Version 2.0 (the "License");
+# you may not use this file except in compliance with the License.
+# You may obtain a copy of the License at
+#
+#     http://www.apache.org/licenses/LICENSE-2.0
+#
+# Unless required by applicable law or agreed to in writing, software
+# distributed under the License is distributed on an "AS IS" BASIS,
+# WITHOUT WARRANTIES OR CONDITIONS OF ANY KIND, either express or implied.
+# See the License for the specific language governing permissions and
+# limitations under the License.
+
+"""
+Tests of the publishing thread: order, bounded backlog, counted drops, clean stop.
+
+A publish function that blocks on an event stands for a slow middleware, so the
+counts are exact whatever the machine's load: the offering side never waits, the
+backlog keeps the newest ``max_backlog`` frames and every other frame is counted
+as dropped. Waits are bounded (hang guards), never timing assertions.
+"""
+
+from __future__ import annotations
+
+import threading
+import time
+from typing import Any, Callable, Sequence
+
+import pytest
+from ttb_sim.node.publishing import PublishLoop
+
+TIMEOUT = 30.0
+
+
+def wait_for(condition: Callable[[], Any], timeout: float = TIMEOUT) -> Any:
+    end = time.monotonic() + timeout
+    while time.monotonic() < end:
+        value = condition()
+        if value:
+            return value
+        time.sleep(0.005)
+    pytest.fail(f'condition not met within {timeout} s')
+
+
+class SlowSink:
+    """Records published batches; the first call blocks until released."""
+
+    def __init__(self) -> None:
+        self.batches: list[list[Any]] = []
+        self.markers = 0
+        self.entered = threading.Event()
+        self.release = threading.Event()
+
+    def __call__(self, frames: Sequence[Any], markers: bool) -> None:
+        self.entered.set()
+        assert self.release.wait(TIMEOUT)
+        self.batches.append(list(frames))
+        self.markers += int(markers)
+
+
+def test_a_slow_publisher_drops_the_oldest_and_never_blocks_the_offer() -> None:
+    sink = SlowSink()
+    loop = PublishLoop(sink, duty=1.0, max_backlog=10)
+    loop.start()
+    try:
+        loop.offer([0])
+        assert sink.entered.wait(TIMEOUT)          # frame 0 is being published
+        loop.offer(list(range(1, 101)), markers=True)   # returns at once: nothing blocks
+        stats = loop.stats()
+        assert stats.offered == 101 and stats.dropped == 90
+        sink.release.set()
+        wait_for(lambda: loop.stats().published == 11)
+    finally:
+        loop.stop()
+    published = [f for batch in sink.batches for f in batch]
+    assert published == [0] + list(range(91, 101))   # in order, the newest kept
+    assert sink.markers == 1
+    assert loop.stats().ms_per_frame > 0
+
+
+def test_publishing_errors_end_the_loop_with_a_message() -> None:
+    def broken(frames: Sequence[Any], markers: bool) -> None:
+        raise RuntimeError('publisher context is invalid')
+
+    loop = PublishLoop(broken, duty=0.5)
+    loop.start()
+    loop.offer([1])
+    wait_for(lambda: loop.error)
+    assert 'publisher context is invalid' in loop.error
+    loop.stop()
+
+
+def test_stop_ends_an_idle_loop_and_offers_after_it_are_harmless() -> None:
+    sink = SlowSink()
+    sink.release.set()
+    loop = PublishLoop(sink, duty=0.4)
+    loop.start()
+    loop.stop()
+    loop.offer([1, 2])
+    assert not sink.batches
+
+
+def test_duty_outside_its_range_is_refused() -> None:
+    with pytest.raises(ValueError, match='duty'):
+        PublishLoop(lambda frames, markers: None, duty=0.0)

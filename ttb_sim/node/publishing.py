@@ -1,0 +1,175 @@
+# Copyright 2026 The ttb_sim Authors
+#
+# Licensed under the Apache License, Version 2.0 (the "License");
+# you may not use this file except in compliance with the License.
+# You may obtain a copy of the License at
+#
+#     http://www.apache.org/licenses/LICENSE-2.0
+#
+# Unless required by applicable law or agreed to in writing, software
+# distributed under the License is distributed on an "AS IS" BASIS,
+# WITHOUT WARRANTIES OR CONDITIONS OF ANY KIND, either express or implied.
+# See the License for the specific language governing permissions and
+# limitations under the License.
+
+"""
+Live publishing off the stepping thread, so that publishing never throttles stepping.
+
+The stepping thread :meth:`PublishLoop.offer` s the frames due for publishing
+and goes on at once; :class:`PublishLoop` turns them into messages on a thread
+of its own. Python runs one thread at a time, so the loop also bounds its own
+share of the wall clock (``duty``): after a batch that took ``s`` seconds it
+rests ``s (1 - duty) / duty``. Frames that arrive faster than that are dropped,
+oldest first, beyond ``max_backlog`` waiting frames, and counted: the
+stepping keeps its pace, the subscribers get fewer frames, and
+:meth:`PublishLoop.stats` says how many (``/diagnostics``).
+"""
+
+from __future__ import annotations
+
+from collections import deque
+from dataclasses import dataclass
+import logging
+import threading
+import time
+from typing import Callable, Sequence
+
+from ttb_sim.sim.frames import Frame
+
+log = logging.getLogger(__name__)
+
+
+@dataclass(frozen=True)
+class PublishStats:
+    """
+    Counters of a :class:`PublishLoop`.
+
+    Attributes
+    ----------
+    offered : int
+        Frames handed to the loop.
+    published : int
+        Frames published.
+    dropped : int
+        Frames dropped because the loop could not keep up.
+    busy : float
+        Wall-clock seconds spent publishing.
+
+    """
+
+    offered: int
+    published: int
+    dropped: int
+    busy: float
+
+    @property
+    def ms_per_frame(self) -> float:
+        """Mean wall-clock milliseconds to publish one frame (0 before the first)."""
+        return 1e3 * self.busy / self.published if self.published else 0.0
+
+
+class PublishLoop:
+    """
+    Publish frames on a thread of its own, within a share of the wall clock.
+
+    Parameters
+    ----------
+    publish : callable
+        ``publish(frames, markers)`` sends the messages of some frames in order;
+        ``markers`` asks for a refresh of the train markers. Exceptions end
+        the loop (logged), never the process.
+    duty : float
+        Largest share of the wall clock the loop spends publishing (0 < duty <= 1).
+    max_backlog : int
+        Frames kept waiting at most; older ones are dropped.
+    clock : callable
+        Wall clock in seconds.
+
+    """
+
+    def __init__(self, publish: Callable[[Sequence[Frame], bool], None], *,
+                 duty: float = 0.4, max_backlog: int = 50,
+                 clock: Callable[[], float] = time.perf_counter) -> None:
+        if not 0 < duty <= 1:
+            raise ValueError(f'duty = {duty!r}: allowed (0, 1]')
+        self._publish = publish
+        self._duty = duty
+        self._clock = clock
+        self._frames: deque[Frame] = deque()
+        self._max_backlog = max_backlog
+        self._markers = False
+        self._cond = threading.Condition()
+        self._stop = False
+        self._offered = 0
+        self._published = 0
+        self._dropped = 0
+        self._busy = 0.0
+        self.error = ''
+        self._thread = threading.Thread(target=self._run, name='ttb_sim-publisher', daemon=True)
+
+    def start(self) -> None:
+        """Start the publishing thread."""
+        self._thread.start()
+
+    def offer(self, frames: Sequence[Frame], markers: bool = False) -> None:
+        """Queue frames for publishing (returns at once; drops the oldest beyond the backlog)."""
+        if not frames and not markers:
+            return
+        with self._cond:
+            self._frames.extend(frames)
+            self._offered += len(frames)
+            excess = len(self._frames) - self._max_backlog
+            for _ in range(max(0, excess)):
+                self._frames.popleft()
+            self._dropped += max(0, excess)
+            self._markers = self._markers or markers
+            self._cond.notify()
+
+    def stop(self, timeout: float = 2.0) -> None:
+        """Stop the thread (frames still waiting are dropped) and wait for it."""
+        with self._cond:
+            self._stop = True
+            self._cond.notify()
+        if self._thread.is_alive() and self._thread is not threading.current_thread():
+            self._thread.join(timeout)
+
+    def stats(self) -> PublishStats:
+        """Return the counters."""
+        with self._cond:
+            return PublishStats(self._offered, self._published, self._dropped, self._busy)
+
+    def _take(self) -> tuple[list[Frame], bool] | None:
+        with self._cond:
+            while not self._stop and not self._frames and not self._markers:
+                self._cond.wait(0.5)
+            if self._stop:
+                return None
+            frames, markers = list(self._frames), self._markers
+            self._frames.clear()
+            self._markers = False
+            return frames, markers
+
+    def _rest(self, seconds: float) -> None:
+        with self._cond:
+            if not self._stop:
+                self._cond.wait_for(lambda: self._stop, timeout=seconds)
+
+    def _run(self) -> None:
+        while True:
+            batch = self._take()
+            if batch is None:
+                return
+            frames, markers = batch
+            start = self._clock()
+            try:
+                self._publish(frames, markers)
+            except Exception as exc:  # noqa: B902 - publishing ends, the node goes on
+                self.error = f'publishing stopped: {type(exc).__name__}: {exc}'
+                log.error(self.error)
+                return
+            spent = self._clock() - start
+            with self._cond:
+                self._published += len(frames)
+                self._busy += spent
+            if self._duty < 1 and spent > 0:
+                self._rest(spent * (1 - self._duty) / self._duty)
