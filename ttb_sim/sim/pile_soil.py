@@ -55,6 +55,7 @@ plastic slip is committed when the step has converged. Output is one
 from __future__ import annotations
 
 from dataclasses import dataclass, replace
+import inspect
 import logging
 import math
 from typing import Callable, Iterator, Literal, Optional
@@ -361,6 +362,11 @@ class PartitionedNewmark:
         return State(state.time + dt, u, v, a, new_slip)
 
 
+_CG_TOLERANCE = 'rtol' if 'rtol' in inspect.signature(sla.cg).parameters else 'tol'
+"""The relative-tolerance argument of scipy's cg: 'rtol' from scipy 1.12, 'tol' before (the
+Debian bookworm scipy 1.10 that a ROS 2 Jazzy build uses)."""
+
+
 def initial_state(model: PileSoilModel) -> State:
     """Return the geostatic state at rest (zero displacement from it, no slip)."""
     n = model.n_dofs
@@ -429,8 +435,8 @@ def static_solve(model: PileSoilModel, force: np.ndarray, increments: int = 5,
             if tangent is not None:
                 assert model.interface is not None
                 k_t = k_lin_free + model.interface.stiffness(tangent)[free][:, free]
-            du, info = sla.cg(k_t, residual, M=preconditioner, rtol=cg_tolerance,
-                              maxiter=20 * len(free))
+            du, info = sla.cg(k_t, residual, M=preconditioner, maxiter=20 * len(free),
+                              **{_CG_TOLERANCE: cg_tolerance})
             if info != 0:
                 raise SimulationError(f'static solve: conjugate gradients stopped ({info})')
             u[free] += du
