@@ -53,6 +53,7 @@ from rclpy.executors import SingleThreadedExecutor  # noqa: E402
 from rclpy.qos import QoSProfile  # noqa: E402
 from rosgraph_msgs.msg import Clock  # noqa: E402
 from std_srvs.srv import SetBool, Trigger  # noqa: E402
+from polling import poll_until  # noqa: E402, I100 - the helper in test/
 
 ROOT = Path(__file__).resolve().parents[1]
 TIMEOUT = 90.0
@@ -163,16 +164,15 @@ class Probe:
 
 def wait_for(condition: Callable[[], Any], timeout: float = TIMEOUT,
              proc: NodeProcess | None = None) -> Any:
-    end = time.monotonic() + timeout
-    while time.monotonic() < end:
-        value = condition()
-        if value:
-            return value
-        if proc is not None and proc.proc.poll() is not None:
-            pytest.fail(f'the node ended early ({proc.proc.returncode}):\n{proc.output()}')
-        time.sleep(0.02)
-    pytest.fail(f'condition not met within {timeout} s'
-                + (f':\n{proc.output()}' if proc is not None else ''))
+    """Poll a condition; with ``proc``, stop when the node ends and show its output."""
+    if proc is None:
+        return poll_until(condition, timeout, interval=0.02)
+
+    def ended() -> str:
+        code = proc.proc.poll()
+        return '' if code is None else f'the node ended early ({code}):\n{proc.output()}'
+
+    return poll_until(condition, timeout, interval=0.02, abort=ended, detail=proc.output)
 
 
 @pytest.fixture

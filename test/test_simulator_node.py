@@ -22,9 +22,10 @@ subscribes to its topics, as ``ros2 param set`` / ``ros2 service call`` would.
 
 from __future__ import annotations
 
+import functools
 import threading
 import time
-from typing import Any, Callable
+from typing import Any
 
 import pytest
 
@@ -45,19 +46,12 @@ from std_srvs.srv import SetBool, Trigger  # noqa: E402
 from ttb_sim.errors import ScenarioError  # noqa: E402
 from ttb_sim.io.topics import topic_table  # noqa: E402
 from ttb_sim.simulator_node import SimulatorNode  # noqa: E402
+from polling import poll_until  # noqa: E402, I100 - the helper in test/
 
 TIMEOUT = 10.0
 
 
-def wait_for(condition: Callable[[], Any], timeout: float = TIMEOUT) -> Any:
-    """Poll a condition until it is truthy; return its value or fail."""
-    end = time.monotonic() + timeout
-    while time.monotonic() < end:
-        value = condition()
-        if value:
-            return value
-        time.sleep(0.01)
-    pytest.fail(f'condition not met within {timeout} s')
+wait_for = functools.partial(poll_until, timeout=TIMEOUT)
 
 
 class Harness:

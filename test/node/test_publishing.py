@@ -23,24 +23,18 @@ as dropped. Waits are bounded (hang guards), never timing assertions.
 
 from __future__ import annotations
 
+import functools
 import threading
-import time
-from typing import Any, Callable, Sequence
+from typing import Any, Sequence
 
 import pytest
 from ttb_sim.node.publishing import PublishLoop
+from polling import poll_until  # noqa: I100 - the helper in test/
 
 TIMEOUT = 30.0
 
 
-def wait_for(condition: Callable[[], Any], timeout: float = TIMEOUT) -> Any:
-    end = time.monotonic() + timeout
-    while time.monotonic() < end:
-        value = condition()
-        if value:
-            return value
-        time.sleep(0.005)
-    pytest.fail(f'condition not met within {timeout} s')
+wait_for = functools.partial(poll_until, timeout=TIMEOUT, interval=0.005)
 
 
 class SlowSink:

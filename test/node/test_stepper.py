@@ -24,10 +24,10 @@ Waits are bounded (hang guards), never timing assertions.
 
 from __future__ import annotations
 
+import functools
 from pathlib import Path
 import threading
-import time
-from typing import Any, Callable
+from typing import Any
 
 import pytest
 from rosbags.highlevel import AnyReader
@@ -37,19 +37,12 @@ from ttb_sim.io.bag import BagRecorder
 from ttb_sim.io.topics import topic_table
 from ttb_sim.node import DEFAULT_SCENARIO, initial_values, parameter_table, Stepper, Tick
 from ttb_sim.sim.frames import Frame, Layout
+from polling import poll_until  # noqa: I100 - the helper in test/
 
 TIMEOUT = 60.0
 
 
-def wait_for(condition: Callable[[], Any], timeout: float = TIMEOUT) -> Any:
-    """Poll until the condition holds (a bound against hangs, not a timing check)."""
-    end = time.monotonic() + timeout
-    while time.monotonic() < end:
-        value = condition()
-        if value:
-            return value
-        time.sleep(0.01)
-    pytest.fail(f'condition not met within {timeout} s')
+wait_for = functools.partial(poll_until, timeout=TIMEOUT)
 
 
 class ThreadRecorder:

@@ -21,15 +21,23 @@ References and tolerances are stated per test.
 import numpy as np
 import pytest
 
+from ttb_sim.config import load_scenario
 from ttb_sim.model.foundation.records import (BlockSize, Interface, MeshSize, Observation,
                                               PAPER_LAYERS, PileGroup, PileLoad, SoilParameters,
                                               Substructure)
 from ttb_sim.model.foundation.substructure import build
-from ttb_sim.sim.pile_soil import (initial_state, observe, PartitionedNewmark, run,
+from ttb_sim.sim.pile_soil import (initial_state, observe, PartitionedNewmark,
                                    stable_time_step, states)
+from ttb_sim.sim.substructure_run import SubstructureRun
 from ttb_sim.validation.cases.pile_soil import (boundary_reflection, harmonic_convergence,
                                                 head_stiffness, randolph_wroth_reference,
                                                 single_pile)
+
+
+PILE_SETS = ['soil.block.lx=12', 'soil.block.ly=12', 'soil.mesh.h=0.8', 'soil.mesh.growth=1.5',
+             'soil.mesh.h_max=2.5', 'piles.side=0.8', 'piles.length=6', 'load.type=static',
+             'load.amplitude=1000']
+"""The built-in single_pile with the mesh and pile of :func:`_pile`."""
 
 
 def _pile(interface='desai'):
@@ -79,8 +87,8 @@ def test_static_frame_and_bonded_vs_desai():
     """Static load gives one frame at t = 0; bonded and Desai stiffness within 10 %."""
     frames = {}
     for interface in ('desai', 'bonded'):
-        frames[interface] = list(run(build(_pile(interface)), PileLoad('static', 1e3, pile=1),
-                                     1.0))
+        scenario = load_scenario('single_pile', PILE_SETS + [f'interface.model={interface}'])
+        frames[interface] = list(SubstructureRun(scenario).frames())
     assert len(frames['desai']) == 1 and frames['desai'][0].time == 0.0
     w = [f[0].pile_displacement[0, 2] for f in frames.values()]
     assert w[0] > 0 and abs(w[0] / w[1] - 1) < 0.1

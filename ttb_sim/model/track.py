@@ -345,12 +345,11 @@ def build_track(track: TrackParameters, bridge_length: float, train_length: floa
     TrackMesh
 
     """
-    approach = approach_length(track, train_length)
+    extent = track_extent(track, bridge_length, train_length)
     s, n_f = track.fastener_spacing, track.fasteners_per_slab
     pitch = n_f * s
     margin = 0.5 * (s - track.slab_gap)
-    x0 = -approach
-    n_units = int(math.ceil((bridge_length + 2.0 * approach) / pitch))
+    x0, n_units = extent.unit_start, extent.n_units
     x1 = x0 + n_units * pitch
 
     # Heights of the layer stack.

@@ -66,7 +66,6 @@ import scipy.sparse.linalg as sla
 
 from ttb_sim.errors import DivergenceError, SimulationError
 from ttb_sim.fe import hex8
-from ttb_sim.model.foundation.records import PileLoad
 from ttb_sim.model.foundation.substructure import PileSoilModel, rayleigh_coefficients
 
 LOG = logging.getLogger(__name__)
@@ -307,13 +306,13 @@ class PartitionedNewmark:
         return (sp.diags(self.m_i) + 0.5 * dt * self.c_i
                 + 0.25 * dt * dt * (self.k_i + k_ifc)).tocsr()
 
-    def step(self, state: State, force: np.ndarray) -> State:
-        """Advance the state by one step; ``force`` is the load at the step end (N)."""
+    def step(self, state: State, force: np.ndarray, load_factor: float = 1.0) -> State:
+        """Advance the state by one step; the load at the step end is ``load_factor * force``."""
         dt = self.dt
         model = self.model
         u_p = state.u + dt * state.v + 0.25 * dt * dt * state.a
         v_p = state.v + 0.5 * dt * state.a
-        rhs = force.copy()
+        rhs = force * load_factor
         if self._fused is not None:
             k_s, b, alpha_m, boundary = self._fused
             rhs -= k_s @ (u_p + b * v_p) + alpha_m * v_p + boundary @ np.concatenate([u_p, v_p])
@@ -327,7 +326,7 @@ class PartitionedNewmark:
         u_i0, v_i0 = u_p[idx], v_p[idx]
         nonlinear = model.interface is not None and state.slip is not None
         u_full = u_p.copy()
-        scale = max(float(np.linalg.norm(r_i)), float(np.linalg.norm(force)),
+        scale = max(float(np.linalg.norm(r_i)), abs(load_factor) * float(np.linalg.norm(force)),
                     float(np.linalg.norm(self.m_i * state.a[idx])),
                     float(np.linalg.norm(self.k_i @ u_i0)), 1e-30)
         factor = self._factor
@@ -456,6 +455,13 @@ def choose_scheme(model: PileSoilModel, scheme: Scheme) -> Literal['mixed', 'imp
     return scheme
 
 
+def mixed_stable_step(model: PileSoilModel) -> float:
+    """Return the stable step (s) of the explicit soil in the mixed scheme."""
+    zeta = np.array([layer.damping_ratio for layer in model.spec.soil.layers])
+    alpha, beta = rayleigh_coefficients(zeta, model.spec.rayleigh_frequencies)
+    return stable_time_step(explicit_omega_max(model), float(alpha.min()), float(beta.max()))
+
+
 def states(model: PileSoilModel, force: np.ndarray, history: Callable[[float], float],
            duration: float, output_dt: float, scheme: Scheme = 'auto',
            newton: Literal['modified', 'full'] = 'modified',
@@ -469,14 +475,10 @@ def states(model: PileSoilModel, force: np.ndarray, history: Callable[[float], f
     resolved = choose_scheme(model, scheme)
     n_sub = 1
     if resolved == 'mixed':
-        spec = model.spec
-        zeta = np.array([layer.damping_ratio for layer in spec.soil.layers])
-        alpha, beta = rayleigh_coefficients(zeta, spec.rayleigh_frequencies)
-        omega = explicit_omega_max(model)
-        dt_stable = stable_time_step(omega, float(alpha.min()), float(beta.max()))
+        dt_stable = mixed_stable_step(model)
         n_sub = max(1, math.ceil(output_dt / dt_stable - 1e-9))
-        LOG.info('mixed scheme: omega_max %.4g rad/s, stable step %.4g s, %d sub-steps of '
-                 '%.4g s', omega, dt_stable, n_sub, output_dt / n_sub)
+        LOG.info('mixed scheme: stable step %.4g s, %d sub-steps of %.4g s', dt_stable, n_sub,
+                 output_dt / n_sub)
     integrator = PartitionedNewmark(model, output_dt / n_sub, resolved, newton)
     state = start if start is not None else initial_state(model)
     yield state
@@ -484,29 +486,5 @@ def states(model: PileSoilModel, force: np.ndarray, history: Callable[[float], f
     for k in range(n_out):
         for s in range(n_sub):
             t = (k * n_sub + s + 1) * integrator.dt
-            state = integrator.step(state, force * history(t))
+            state = integrator.step(state, force, history(t))
         yield state
-
-
-def default_output_dt(load: PileLoad) -> float:
-    """Return 1/20 of the load period (s), or 5 ms for a static load."""
-    if load.type == 'static':
-        return 0.005
-    return 1.0 / (20.0 * load.frequency)
-
-
-def run(model: PileSoilModel, load: PileLoad, duration: float,
-        output_dt: Optional[float] = None, scheme: Scheme = 'auto') -> Iterator[PileSoilFrame]:
-    """
-    Run the substructure under a load record and yield observed frames.
-
-    A static load gives one frame at t = 0 with the static solution; a
-    harmonic or pulse load starts from rest at t = 0.
-    """
-    force = model.load_vector(load)
-    if load.type == 'static':
-        yield observe(model, static_solve(model, force))
-        return
-    dt = default_output_dt(load) if output_dt is None else output_dt
-    for state in states(model, force, load.history, duration, dt, scheme):
-        yield observe(model, state)

@@ -40,11 +40,11 @@ import numpy as np
 
 from ttb_sim.config import Scenario
 from ttb_sim.errors import DivergenceError, ScenarioError
-from ttb_sim.model.foundation.substructure import build, PileSoilModel, rayleigh_coefficients
+from ttb_sim.model.foundation.substructure import build, PileSoilModel
 from ttb_sim.sim.cost import CostEstimate, STEP_BUDGET
 from ttb_sim.sim.frames import Frame, Layout
-from ttb_sim.sim.pile_soil import (choose_scheme, explicit_omega_max, initial_state, observe,
-                                   PartitionedNewmark, stable_time_step, State, static_solve)
+from ttb_sim.sim.pile_soil import (choose_scheme, initial_state, mixed_stable_step, observe,
+                                   PartitionedNewmark, State, static_solve)
 from ttb_sim.sim.variants import blas_threads
 
 __all__ = ['SubstructureRun', 'AUTO_STEPS_PER_PERIOD', 'AUTO_PERIODS']
@@ -113,10 +113,7 @@ class SubstructureRun:
             self.dt, self.n_steps, self.output_every = 0.0, 0, 1
             return
         if self.scheme == 'mixed':
-            zeta = np.array([layer.damping_ratio for layer in model.spec.soil.layers])
-            alpha, beta = rayleigh_coefficients(zeta, model.spec.rayleigh_frequencies)
-            self.stable_step = stable_time_step(explicit_omega_max(model), float(alpha.min()),
-                                                float(beta.max()))
+            self.stable_step = mixed_stable_step(model)
         # the largest step both wanted and stable, shortened so that frames fall on steps
         largest = min(wanted, self.stable_step)
         rate = scenario.output.rate_hz
@@ -187,7 +184,7 @@ class SubstructureRun:
             yield self._frame(0, state)
             history = self.load.history
             for step in range(1, self.n_steps + 1):
-                state = self.integrator.step(state, self.force * history(step * self.dt))
+                state = self.integrator.step(state, self.force, history(step * self.dt))
                 if step % self.output_every == 0:
                     yield self._frame(step, state)
 

@@ -168,13 +168,20 @@ class QuarterCarCoupling:
         s = np.eye(m) + np.einsum('ik,ikj->ij', w, z[dofs])
         t = np.einsum('ik,ik->i', w, x0[dofs])
         u_ext = x0 - z @ np.linalg.solve(s, t)
-        u_new = u_ext[:n_free]
+        return self._finish(u_ext, dofs, w, b, p, e, hs_v, hs_a, h_v, h_a)
 
+    def _finish(self, u_ext: np.ndarray, dofs: np.ndarray, w: np.ndarray, b: np.ndarray,
+                p: np.ndarray, e: np.ndarray, hs_v: np.ndarray, hs_a: np.ndarray,
+                h_v: np.ndarray, h_a: np.ndarray
+                ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Update the cars and contact forces from the girder state ``u_ext`` (zero slot last)."""
+        nm = self.nm
         wu = np.einsum('ik,ik->i', p, u_ext[dofs])
-        self.z = (e + wu) / d
-        self.v = a1 * self.z + hs_v
-        self.a = a0 * self.z + hs_a
+        self.z = (e + wu) / self._d
+        self.v = nm.a1 * self.z + hs_v
+        self.a = nm.a0 * self.z + hs_a
         self.contact = np.einsum('ik,ik->i', w, u_ext[dofs]) + b
+        u_new = u_ext[:self.n_free]
         v_new, a_new = nm.finish(u_new, h_v, h_a)
         return u_new, v_new, a_new
 
@@ -198,16 +205,8 @@ class QuarterCarCoupling:
         t = np.einsum('ik,ik->i', w, x0[dofs])
         y = np.linalg.solve(s, t)
         unit = np.bincount(flat, weights=(n0 * y[:, None]).ravel(), minlength=n_free + 1)
-        u_new = nm.solve(base - unit[:n_free])
-        u_ext = np.append(u_new, 0.0)
-        wu = np.einsum('ik,ik->i', p, u_ext[dofs])
-        d, a0, a1 = self._d, nm.a0, nm.a1
-        self.z = (e + wu) / d
-        self.v = a1 * self.z + hs_v
-        self.a = a0 * self.z + hs_a
-        self.contact = np.einsum('ik,ik->i', w, u_ext[dofs]) + b
-        v_new, a_new = nm.finish(u_new, h_v, h_a)
-        return u_new, v_new, a_new
+        u_ext = np.append(nm.solve(base - unit[:n_free]), 0.0)
+        return self._finish(u_ext, dofs, w, b, p, e, hs_v, hs_a, h_v, h_a)
 
 
 class QuarterCarTrain:
