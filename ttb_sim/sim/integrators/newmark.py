@@ -69,6 +69,9 @@ class Newmark:
             self._history = np.zeros(2 * n)
             self._h_a, self._h_v = self._history[:n], self._history[n:]
             self._work = np.zeros(n)
+        self.external: np.ndarray | None = None
+        """Load added to every effective right-hand side: the bearing forces of
+        partitioned substructures on the girders, set before each step (None: none)."""
         self._history_kernel = kernels.compiled('history') if lean else None
         self._finish_kernel = kernels.compiled('finish') if lean else None
 
@@ -98,10 +101,14 @@ class Newmark:
         return h_v, h_a
 
     def effective_load(self, force: np.ndarray, h_v: np.ndarray, h_a: np.ndarray) -> np.ndarray:
-        """Return the right-hand side f_{n+1} - M h_a - C h_v of the effective system."""
+        """Return f_{n+1} (+ :attr:`external`) - M h_a - C h_v, the effective right-hand side."""
         if self.lean and h_a is self._h_a and h_v is self._h_v:
-            return force - self._stacked @ self._history
-        return force - self.mass @ h_a - self.damping @ h_v
+            rhs = force - self._stacked @ self._history
+        else:
+            rhs = force - self.mass @ h_a - self.damping @ h_v
+        if self.external is not None:
+            rhs += self.external
+        return rhs
 
     def solve(self, rhs: np.ndarray) -> np.ndarray:
         """Solve the effective system for one or several right-hand sides."""
