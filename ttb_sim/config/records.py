@@ -139,6 +139,15 @@ class SolverConfig:
                          '(opt-in) is qdldl with the slab track detailed only in a window '
                          'around the train, the far track condensed onto the bridge.',
                          choices=('qdldl', 'cholmod', 'superlu_sym', 'reference', 'reduced'))
+    substructure_steps: int = param(3, '-', 'Piled foundations: solver steps per substructure '
+                                    'step n ([P] Eqs. 13-14: the substructures advance at '
+                                    'n dt, the pier tops interpolated in between); 1 = every '
+                                    'step.', low=1, high=100)
+    coupling: str = param('partitioned', '-', "Piled foundations: 'partitioned' exchanges the "
+                          'bearing forces between bridge and substructures ([P] Eq. 12, '
+                          "multi-time-step); 'monolithic' solves them as one system ([P] "
+                          'Eq. 11, the reference; substructure_steps must be 1).',
+                          choices=('partitioned', 'monolithic'))
 
 
 @dataclass(frozen=True)
@@ -213,7 +222,12 @@ class Scenario:
 
     def echo(self) -> dict[str, Any]:
         """Return the sections the run uses as plain nested dicts (for ``summary.json``)."""
-        unused = TRAIN_SECTIONS if self.substructure_only else SUBSTRUCTURE_SECTIONS
+        if self.substructure_only:
+            unused: tuple[str, ...] = TRAIN_SECTIONS
+        elif self.foundation.model == 'piled':
+            unused = ('load',)
+        else:
+            unused = SUBSTRUCTURE_SECTIONS
         return {k: v for k, v in self.to_dict().items() if k not in unused}
 
 
@@ -240,9 +254,10 @@ def _check_consistency(s: Scenario) -> None:
     if s.bridge.elements_per_span % 2:
         raise ScenarioError(f'bridge.elements_per_span = {s.bridge.elements_per_span}: must be '
                             'even, so that a node sits at mid-span')
-    if s.foundation.model == 'springs' and s.bearings.model == 'rigid':
-        raise ScenarioError("foundation.model = 'springs' needs bearings.model = 'elastic' "
-                            '(rigid bearings model ideal fixed supports)')
+    if s.foundation.model in ('springs', 'piled') and s.bearings.model == 'rigid':
+        raise ScenarioError(f'foundation.model = {s.foundation.model!r} needs bearings.model = '
+                            "'elastic' (rigid bearings model ideal fixed supports)")
+    _check_piled(s)
     if s.train.vehicle == 'car' and s.track.model != 'slab':
         raise ScenarioError(f"train.vehicle = 'car' needs track.model = 'slab' (got "
                             f'{s.track.model!r}): wheels run on rails')
@@ -252,6 +267,32 @@ def _check_consistency(s: Scenario) -> None:
     _check_model_size(s)
     _check_track_fit(s)
     _check_observers(s)
+
+
+def _check_piled(s: Scenario) -> None:
+    """Refuse piled piers that are not piers, or a coupling the solver cannot do."""
+    fd, solver = s.foundation, s.solver
+    if fd.model != 'piled':
+        if solver.coupling == 'monolithic':
+            raise ScenarioError("solver.coupling = 'monolithic' needs foundation.model = "
+                                "'piled' (there is no substructure to couple)")
+        return
+    last = s.bridge.n_spans
+    outside = [p for p in fd.piled_piers if not 2 <= p <= last]
+    if outside:
+        raise ScenarioError(f'foundation.piled_piers = {list(fd.piled_piers)!r}: '
+                            f'{outside[0]} is not a pier; allowed: 2 to {last} (supports 1 and '
+                            f'{last + 1} are the abutments of bridge.n_spans = {last})')
+    if not s.cap.enabled:
+        raise ScenarioError("foundation.model = 'piled' needs cap.enabled = true (the pier "
+                            'stands on the cap)')
+    if solver.coupling == 'monolithic' and solver.substructure_steps != 1:
+        raise ScenarioError(f"solver.coupling = 'monolithic' needs solver.substructure_steps = "
+                            f'1 (got {solver.substructure_steps}): one system has one step')
+    if solver.variant == 'reduced':
+        raise ScenarioError("solver.variant = 'reduced' does not support foundation.model = "
+                            "'piled'; allowed: qdldl, cholmod, superlu_sym, reference")
+    _check_substructure(s)
 
 
 MAX_SOIL_NODES = 600_000
@@ -280,8 +321,9 @@ MAX_MODEL_NODES = 200_000
 def model_nodes(s: Scenario) -> int:
     """Count the beam nodes the model of a scenario will have, before building it."""
     nodes = s.bridge.n_spans * (s.bridge.elements_per_span + 1)
-    if s.foundation.model == 'springs':
-        nodes += (s.bridge.n_spans - 1) * (s.piers.elements + 1)
+    if s.foundation.model in ('springs', 'piled'):
+        piers = s.bridge.n_spans - 1 - len(s.foundation.piled_piers)
+        nodes += max(piers, 0) * (s.piers.elements + 1)
     if s.track.model == 'slab':
         t = s.track
         units = _extent(s).n_units

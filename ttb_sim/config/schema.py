@@ -192,11 +192,12 @@ def _coerce(path: str, value: Any, typ: Any, spec: Spec) -> Any:
                                 f'mappings with keys {_field_names(record)}')
         return tuple(from_mapping(item, record, prefix=f'{path}[{i}].')
                      for i, item in enumerate(value))
-    if typ in (tuple[float, ...],):
+    if typ in (tuple[float, ...], tuple[int, ...]):
+        kind = typing.get_args(typ)[0]
         if not isinstance(value, (list, tuple)):
-            raise ScenarioError(f'{path} = {shown(value)}: expected a list of numbers '
-                                f'({spec.unit})')
-        items = tuple(_coerce_number(f'{path}[{i}]', v, float, spec)
+            raise ScenarioError(f'{path} = {shown(value)}: expected a list of '
+                                f'{"integers" if kind is int else "numbers"} ({spec.unit})')
+        items = tuple(_coerce_number(f'{path}[{i}]', v, kind, spec)
                       for i, v in enumerate(value))
         return items
     if typ in (tuple[tuple[float, ...], ...],):

@@ -32,13 +32,16 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 import math
+from typing import Mapping
 
 import numpy as np
 import scipy.sparse as sp
 
+from ttb_sim.errors import ModelError
 from ttb_sim.fe.assembly import assemble, assemble_links, link_kinematics
 from ttb_sim.fe.beam import BeamSection, global_matrices, NODE_DOFS, vertical_row, W_DOFS
 from ttb_sim.fe.dofs import DofMap
+from ttb_sim.model.foundation.operator import FoundationOperator
 from ttb_sim.model.track import BeamLine, build_track, TrackMesh, TrackParameters
 from ttb_sim.parameters import check_declared, param
 
@@ -132,8 +135,14 @@ class FoundationParameters:
     """Foundations of the intermediate piers; abutments are always rigid."""
 
     model: str = param('rigid', '-', "'rigid': bearings sit on fixed supports; 'springs': "
-                       'piers on foundation springs ([P] Table 4).',
-                       choices=('rigid', 'springs'))
+                       "piers on foundation springs ([P] Table 4); 'piled': the piers of "
+                       'piled_piers stand on the 3-D cap-pile-soil substructure of the soil, '
+                       'piles, cap and interface keys, the others on springs.',
+                       choices=('rigid', 'springs', 'piled'))
+    piled_piers: tuple[int, ...] = param((), '-', 'Supports on piled foundations when model = '
+                                         "'piled', numbered 1 (first abutment) to n_spans + 1 "
+                                         '(last abutment): intermediate piers only. '
+                                         'VALIDATION.md: [7, 8].', low=2, high=50)
     vertical_stiffness: float = param(6e9, 'N/m', 'Vertical foundation spring ([P] Table 4).',
                                       low=0.0, high=1e15, low_inclusive=False)
     lateral_stiffness: float = param(6e8, 'N/m', 'Lateral and longitudinal foundation spring '
@@ -145,8 +154,25 @@ class FoundationParameters:
                            low=0.0, high=1e12)
 
     def __post_init__(self) -> None:
-        """Check every field against its declaration."""
+        """Check every field against its declaration, and the piled piers."""
         check_declared(self, 'foundation parameter')
+        piers = self.piled_piers
+        if any(isinstance(p, bool) or not isinstance(p, int) or p < 2 for p in piers):
+            raise ModelError(f'foundation.piled_piers = {list(piers)!r} is invalid; allowed: '
+                             'support numbers >= 2 (1 is the first abutment)')
+        if len(set(piers)) != len(piers):
+            raise ModelError(f'foundation.piled_piers = {list(piers)!r} names a pier twice')
+        if self.model == 'piled' and not piers:
+            raise ModelError("foundation.model = 'piled' needs foundation.piled_piers, e.g. "
+                             '[7, 8] (support numbers of the piled piers)')
+        if self.model != 'piled' and piers:
+            raise ModelError(f'foundation.piled_piers = {list(piers)!r} needs '
+                             f"foundation.model = 'piled' (got {self.model!r})")
+
+    @property
+    def piled(self) -> tuple[int, ...]:
+        """0-based support indices of the piled piers, in ascending order."""
+        return tuple(sorted(p - 1 for p in self.piled_piers))
 
 
 @dataclass(frozen=True)
@@ -253,6 +279,26 @@ class RigidSupports:
 
 
 @dataclass(frozen=True)
+class PiledPier:
+    """
+    A pier standing on a cap-pile-soil substructure (``foundation.model: piled``).
+
+    The bridge meets it only through the bearings of its support. Monolithic: its
+    coordinates q are DOFs of the structure (``block``); partitioned: it is
+    stepped beside the bridge (:mod:`ttb_sim.sim.piled_foundations`) and the
+    bearings of the support see its pier top as a moving support.
+    """
+
+    support: int
+    """0-based support index."""
+    operator: FoundationOperator
+    links: np.ndarray
+    """Indices of the support's bearings in :attr:`Structure.bearings`."""
+    block: np.ndarray | None
+    """Monolithic: extended free index of each coordinate q; partitioned: None."""
+
+
+@dataclass(frozen=True)
 class Structure:
     """
     Assembled bridge: free-DOF matrices and the sensors defined on them.
@@ -284,6 +330,8 @@ class Structure:
     """The girders as a beam line (full DOFs), for point lookups of all six fields."""
     track: TrackMesh | None = None
     """The slab track (full DOF numbering), if modelled."""
+    piled: tuple[PiledPier, ...] = ()
+    """The piled piers, by support."""
 
     @property
     def n_free(self) -> int:
@@ -353,10 +401,10 @@ def girder_block(b: BridgeParameters) -> tuple[BeamBlock, np.ndarray]:
     return BeamBlock(coords, elements, section), girder_nodes
 
 
-def pier_block(pr: PierParameters, n_spans: int, span: float,
-               first_node: int) -> tuple[BeamBlock, np.ndarray, np.ndarray]:
+def pier_block(pr: PierParameters, n_spans: int, span: float, first_node: int,
+               skip: tuple[int, ...] = ()) -> tuple[BeamBlock, np.ndarray, np.ndarray]:
     """
-    Return the pier columns under the intermediate supports (top node first).
+    Return the pier columns under the intermediate supports but ``skip`` (top node first).
 
     Returns
     -------
@@ -371,16 +419,22 @@ def pier_block(pr: PierParameters, n_spans: int, span: float,
     zp = -np.linspace(0.0, pr.height, npe + 1)
     coords, conn = [np.zeros((0, 3))], [np.zeros((0, 2), dtype=int)]
     n_nodes = first_node
-    for s in range(1, n_spans):
+    piers = [s for s in range(1, n_spans) if s not in skip]
+    for s in piers:
         ids = n_nodes + np.arange(npe + 1)
         coords.append(np.column_stack([np.full(npe + 1, s * span), np.zeros(npe + 1), zp]))
         conn.append(np.column_stack([ids[:-1], ids[1:]]))
         pier_top[s], pier_base[s] = ids[0], ids[-1]
         n_nodes += npe + 1
-    section = _uniform_section((n_spans - 1) * npe, pr.axial_stiffness,
-                               pr.torsional_stiffness, pr.bending_stiffness,
-                               pr.bending_stiffness, pr.mass_per_length, pr.mass_per_length)
+    section = pier_section(pr, len(piers) * npe)
     return BeamBlock(np.concatenate(coords), np.concatenate(conn), section), pier_top, pier_base
+
+
+def pier_section(pr: PierParameters, n: int | None = None) -> BeamSection:
+    """Return the section of ``n`` pier elements (default: one pier's)."""
+    return _uniform_section(pr.elements if n is None else n, pr.axial_stiffness,
+                            pr.torsional_stiffness, pr.bending_stiffness, pr.bending_stiffness,
+                            pr.mass_per_length, pr.mass_per_length)
 
 
 def _rigid_end_dofs(ends: np.ndarray, end_support: np.ndarray
@@ -398,9 +452,13 @@ def _rigid_end_dofs(ends: np.ndarray, end_support: np.ndarray
 
 
 def _bearing_links(br: BearingParameters, ends: np.ndarray, end_support: np.ndarray,
-                   pier_top: np.ndarray) -> tuple[np.ndarray, ...]:
+                   pier_top: np.ndarray, moving: np.ndarray) -> tuple[np.ndarray, ...]:
     """
     Return the elastic bearings as links between girder ends and pier tops (or ground).
+
+    ``moving`` marks the supports (partitioned piled piers) whose pier top is not
+    a node of the structure: their links are assembled as on ground, but the
+    kinematics keep the pier-top arm for the substructure's motion.
 
     Returns
     -------
@@ -415,7 +473,7 @@ def _bearing_links(br: BearingParameters, ends: np.ndarray, end_support: np.ndar
     arm = np.column_stack([np.zeros(side.size), np.where(side == 0, e, -e),
                            np.zeros(side.size)])
     top = pier_top[support]
-    kin = link_kinematics(arm, np.where((top >= 0)[:, None], arm, 0.0))
+    kin = link_kinematics(arm, np.where(((top >= 0) | moving[support])[:, None], arm, 0.0))
     kdir = np.tile([br.longitudinal_stiffness, br.lateral_stiffness,
                     br.vertical_stiffness], (side.size, 1))
     cdir = np.tile([br.lateral_damping, br.lateral_damping, br.vertical_damping],
@@ -442,7 +500,9 @@ def _foundation_springs(fd: FoundationParameters, bases: np.ndarray,
 
 def assemble_structure(b: BridgeParameters, br: BearingParameters, pr: PierParameters,
                        fd: FoundationParameters, track_parameters: TrackParameters | None,
-                       train_length: float) -> Structure:
+                       train_length: float,
+                       foundations: Mapping[int, FoundationOperator] | None = None,
+                       monolithic: bool = False) -> Structure:
     """
     Assemble girders, bearings, piers, foundations and the slab track (once).
 
@@ -458,6 +518,12 @@ def assemble_structure(b: BridgeParameters, br: BearingParameters, pr: PierParam
         The slab track, or None when loads act on the girder axis.
     train_length
         Head to last axle or car end (m): the automatic approach length.
+    foundations
+        ``foundation.model: piled``: the substructure of each piled pier by
+        0-based support index.
+    monolithic
+        Make the substructures' coordinates DOFs of the structure ([P] Eq. 11)
+        instead of leaving them to a partitioned driver (Eq. 12).
 
     Returns
     -------
@@ -471,8 +537,9 @@ def assemble_structure(b: BridgeParameters, br: BearingParameters, pr: PierParam
     n_girder_nodes = girder_nodes.size
     pier_top = np.full(n_supports, -1)
     pier_base = np.full(n_supports, -1)
-    if fd.model == 'springs':
-        piers, pier_top, pier_base = pier_block(pr, n_spans, span, n_girder_nodes)
+    piled = tuple(sorted((foundations or {}).keys()))
+    if fd.model in ('springs', 'piled'):
+        piers, pier_top, pier_base = pier_block(pr, n_spans, span, n_girder_nodes, piled)
         if piers.elements.size:
             blocks.append(piers)
     n_bridge_nodes = n_girder_nodes + sum(blk.coords.shape[0] for blk in blocks[1:])
@@ -493,7 +560,19 @@ def assemble_structure(b: BridgeParameters, br: BearingParameters, pr: PierParam
         conn.append(track.elements)
         sections.append(track.sections)
     xyz = np.concatenate(coords)
-    n_nodes = xyz.shape[0]
+    n_nodes = n_beam_nodes = xyz.shape[0]
+    # monolithic substructures: their coordinates as pseudo-nodes after the beams, the
+    # pier top first (q[:6] is one node), the padding of the last node constrained
+    blocks_q: dict[int, np.ndarray] = {}
+    padding: list[np.ndarray] = []
+    if monolithic:
+        for support in piled:
+            size = foundations[support].size  # type: ignore[index]
+            count = -(-size // NODE_DOFS)
+            pier_top[support] = n_nodes
+            blocks_q[support] = n_nodes * NODE_DOFS + np.arange(size)
+            padding.append(n_nodes * NODE_DOFS + np.arange(size, count * NODE_DOFS))
+            n_nodes += count
     elements = np.concatenate(conn)
     section = BeamSection(*(np.concatenate([getattr(s, f) for s in sections])
                             for f in ('ea', 'gj', 'ei_y', 'ei_z', 'mass', 'inertia_x')))
@@ -502,6 +581,10 @@ def assemble_structure(b: BridgeParameters, br: BearingParameters, pr: PierParam
     ke, me, _ = global_matrices(xyz[elements[:, 0]], xyz[elements[:, 1]], section)
     k_beam = assemble(n_full, edofs, ke)
     m_full = assemble(n_full, edofs, me)
+    for support, full in blocks_q.items():
+        op = foundations[support]  # type: ignore[index]
+        k_beam = k_beam + _dense_block(n_full, full, op.stiffness)
+        m_full = m_full + _dense_block(n_full, full, op.mass)
 
     # Rayleigh damping for the girders and piers only; the track is damped by its
     # fasteners and layers.
@@ -510,6 +593,8 @@ def assemble_structure(b: BridgeParameters, br: BearingParameters, pr: PierParam
     nb = slice(0, n_bridge_el)
     c_full = (a0 * assemble(n_full, edofs[nb], me[nb])
               + a1 * assemble(n_full, edofs[nb], ke[nb])).tocsr()
+    for support, full in blocks_q.items():
+        c_full = c_full + _dense_block(n_full, full, foundations[support].damping)  # type: ignore
     k_full = k_beam.copy()
     if track is not None:
         for links in track.links:
@@ -520,6 +605,8 @@ def assemble_structure(b: BridgeParameters, br: BearingParameters, pr: PierParam
 
     # Interfaces: bearings between girder ends and supports, foundations under piers.
     constrained = np.zeros(n_full, dtype=bool)
+    if padding:
+        constrained[np.concatenate(padding)] = True
     ends = np.stack([girder_nodes[:, 0], girder_nodes[:, -1]], axis=1)  # (n_spans, 2)
     end_support = np.stack([np.arange(n_spans), np.arange(1, n_spans + 1)], axis=1)
     bearing_links = None
@@ -527,7 +614,9 @@ def assemble_structure(b: BridgeParameters, br: BearingParameters, pr: PierParam
         cdofs, c_support, c_component = _rigid_end_dofs(ends, end_support)
         constrained[cdofs] = True
     else:
-        bearing_links = _bearing_links(br, ends, end_support, pier_top)
+        moving = np.zeros(n_supports, dtype=bool)
+        moving[list(piled)] = not monolithic
+        bearing_links = _bearing_links(br, ends, end_support, pier_top, moving)
         kin, link_full, kdir, cdir = bearing_links[:4]
         k_full = k_full + assemble_links(n_full, link_full, kin, kdir)
         c_full = c_full + assemble_links(n_full, link_full, kin, cdir)
@@ -541,7 +630,8 @@ def assemble_structure(b: BridgeParameters, br: BearingParameters, pr: PierParam
         n_nodes, NODE_DOFS, constrained,
         {'girders': np.arange(n_girder_nodes),
          'piers': np.arange(n_girder_nodes, n_bridge_nodes),
-         'track': np.arange(n_bridge_nodes, n_nodes)},
+         'track': np.arange(n_bridge_nodes, n_beam_nodes),
+         'substructures': np.arange(n_beam_nodes, n_nodes)},
         {'bearings': np.concatenate([ends.ravel(), pier_top[pier_top >= 0]]),
          'foundations': bases})
     free, full_to_free = dof_map.free, dof_map.full_to_free
@@ -571,12 +661,24 @@ def assemble_structure(b: BridgeParameters, br: BearingParameters, pr: PierParam
                         w_dofs=full_to_free[wfull], w_dofs_full=wfull)
     mid = girder_nodes[:, ne // 2]
     midspan = full_to_free[mid[:, None] * NODE_DOFS + np.arange(3)]
+    piled_piers = tuple(
+        PiledPier(support=s, operator=foundations[s],  # type: ignore[index]
+                  links=np.flatnonzero(bearings.support == s) if bearings else np.zeros(0, int),
+                  block=full_to_free[blocks_q[s]] if s in blocks_q else None)
+        for s in piled)
     return Structure(mass=reduce(m_full), damping=reduce(c_full), stiffness=reduce(k_full),
                      dofs=dof_map, girder=girder,
                      midspan_dofs=midspan, bearings=bearings, rigid=rigid,
                      n_supports=n_supports, bearing_spacing=br.spacing,
                      fundamental_frequency=f1, rayleigh=(a0, a1),
-                     girder_beam=girder_beam, track=track)
+                     girder_beam=girder_beam, track=track, piled=piled_piers)
+
+
+def _dense_block(n_full: int, full: np.ndarray, block: np.ndarray) -> sp.csr_matrix:
+    """Return a dense block on the full DOFs ``full`` as an n_full x n_full sparse matrix."""
+    rows = np.repeat(full, full.size)
+    cols = np.tile(full, full.size)
+    return sp.csr_matrix((block.ravel(), (rows, cols)), shape=(n_full, n_full))
 
 
 def _uniform_section(n: int, ea: float, gj: float, ei_y: float, ei_z: float, mass: float,
@@ -586,7 +688,8 @@ def _uniform_section(n: int, ea: float, gj: float, ei_y: float, ei_z: float, mas
 
 
 def bearing_forces(structure: Structure, u: np.ndarray, v: np.ndarray, a: np.ndarray,
-                   load_full: np.ndarray) -> np.ndarray:
+                   load_full: np.ndarray,
+                   tops: tuple[np.ndarray, np.ndarray] | None = None) -> np.ndarray:
     """
     Return the force each support receives from its bearings (N).
 
@@ -598,6 +701,9 @@ def bearing_forces(structure: Structure, u: np.ndarray, v: np.ndarray, a: np.nda
         Extended free displacement, velocity and acceleration (last slot zero).
     load_full : array
         Applied load on the full DOFs (used for loads sitting on a rigid support).
+    tops : (u, v) arrays (n_supports, 6), optional
+        Displacement and velocity of the pier tops that are not structure DOFs
+        (partitioned piled piers; zero rows elsewhere).
 
     Returns
     -------
@@ -611,6 +717,10 @@ def bearing_forces(structure: Structure, u: np.ndarray, v: np.ndarray, a: np.nda
         bg = structure.bearings
         d = np.einsum('eai,ei->ea', bg.kinematics, u[bg.dofs])
         dv = np.einsum('eai,ei->ea', bg.kinematics, v[bg.dofs])
+        if tops is not None:
+            pier = bg.kinematics[:, :, NODE_DOFS:]
+            d += np.einsum('eai,ei->ea', pier, tops[0][bg.support])
+            dv += np.einsum('eai,ei->ea', pier, tops[1][bg.support])
         force = bg.stiffness * d + bg.damping * dv
         np.add.at(out, (bg.support, bg.side), force)
         return out

@@ -29,7 +29,9 @@ import numpy as np
 from ttb_sim.config import car_layout, Scenario
 from ttb_sim.errors import ScenarioError
 from ttb_sim.inputs import shown
-from ttb_sim.model.bridge import assemble_structure, Structure
+from ttb_sim.model.bridge import (assemble_structure, pier_section, rayleigh_coefficients,
+                                  span_frequency, Structure)
+from ttb_sim.model.foundation.operator import FoundationOperator
 from ttb_sim.model.irregularity import load_csv, synthesize, TrackIrregularity
 from ttb_sim.model.vehicle.train import Axles, MovingForces, MultibodyCars, QuarterCars, Vehicle
 from ttb_sim.sim.coupling.base import Coupling
@@ -53,10 +55,33 @@ def train_length(scenario: Scenario) -> float:
 
 
 def build_structure(scenario: Scenario) -> Structure:
-    """Assemble the bridge (and slab track) of a scenario, once, before time stepping."""
+    """Assemble the bridge (and slab track, and piled piers) of a scenario, once."""
     track = scenario.track if scenario.track.model == 'slab' else None
-    return assemble_structure(scenario.bridge, scenario.bearings, scenario.piers,
-                              scenario.foundation, track, train_length(scenario))
+    fd = scenario.foundation
+    foundations = None
+    if fd.model == 'piled':
+        operator = build_foundation(scenario)  # every piled pier stands on the same ground
+        foundations = {support: operator for support in fd.piled}
+    return assemble_structure(scenario.bridge, scenario.bearings, scenario.piers, fd, track,
+                              train_length(scenario), foundations,
+                              monolithic=scenario.solver.coupling == 'monolithic')
+
+
+def build_foundation(scenario: Scenario) -> FoundationOperator:
+    """
+    Return the substructure of a piled pier: its column on the cap-pile-soil block.
+
+    The pier column is damped like the bridge's beams (Rayleigh, the girder's
+    ratio at its first and fourth bending frequencies); the soil, piles and cap
+    as their own records say.
+    """
+    from ttb_sim.model.foundation.reduction import pile_soil_operator
+
+    b, pr = scenario.bridge, scenario.piers
+    f1 = span_frequency(b.span_length, b.bending_stiffness, b.mass_per_length)
+    return pile_soil_operator(scenario.substructure(), pr.height, pr.elements,
+                              pier_section(pr), rayleigh_coefficients(b.damping_ratio, f1,
+                                                                      4 * f1))
 
 
 def build_vehicle(scenario: Scenario) -> Vehicle:

@@ -36,6 +36,7 @@ from ttb_sim.sim.build import (build_coupling, build_structure, build_vehicle, o
 from ttb_sim.sim.cost import CostEstimate, estimate_cost, STEP_BUDGET
 from ttb_sim.sim.frames import Frame, Layout
 from ttb_sim.sim.integrators.newmark import Newmark
+from ttb_sim.sim.piled_foundations import pile_outputs, PiledFoundations
 from ttb_sim.sim.variants import blas_threads, solver_variant
 
 log = logging.getLogger(__name__)
@@ -136,9 +137,14 @@ class Simulation:
             self.coupling = build_coupling(scenario, st, self.vehicle, self.integrator,
                                            self.irregularity, lean=self.variant.lean,
                                            reduced=self.variant.reduced)
+        self.foundations = PiledFoundations(st, self.integrator,
+                                            scenario.solver.substructure_steps)
         self.layout = Layout(n_spans=scenario.bridge.n_spans, n_supports=st.n_supports,
                              n_bodies=self.coupling.n_bodies, n_axles=self.coupling.n_axles,
-                             observers=names)
+                             observers=names,
+                             piles=tuple((p.support + 1, p.operator.n_piles) for p in st.piled),
+                             soil_points=sum(len(p.operator.soil_point_names)
+                                             for p in st.piled))
         log.info('model: %d free DOFs, %d axles, dt = %.3g s, %d steps', st.n_free,
                  self.vehicle.axles.count, dt, self.n_steps)
 
@@ -241,12 +247,19 @@ class Simulation:
     def _frames(self) -> Iterator[Frame]:
         cp, dt = self.coupling, self.dt
         head = self.scenario.train.start_position
+        fd = self.foundations if self.foundations.active else None
         cp.start(head)
         yield self._frame(0, head)
         for step in range(1, self.n_steps + 1):
             head += self.speed * dt
+            if fd is not None:
+                fd.before_step()
             cp.step(head, self.speed)
-            self._check_state(step, *cp.monitored())
+            if fd is not None:
+                fd.after_step(*cp.structure_state()[:2])
+                self._check_state(step, *cp.monitored(), *(s.u for s in fd.current()))
+            else:
+                self._check_state(step, *cp.monitored())
             if step % self.output_every == 0:
                 yield self._frame(step, head)
 
@@ -268,9 +281,11 @@ class Simulation:
         st, cp = self.structure, self.coupling
         ue, ve, ae = (np.append(x, 0.0) for x in cp.structure_state())
         vehicle = cp.vehicle_outputs()
+        tops = self.foundations.tops() if self.foundations.active else None
+        piles = pile_outputs(st, self.foundations, ue, ve, ae)
         return Frame(step=step, time=step * self.dt, head_position=head, speed=self.speed,
                      midspan=ue[st.midspan_dofs],
-                     bearings=bearing_forces(st, ue, ve, ae, cp.structure_load(head)),
+                     bearings=bearing_forces(st, ue, ve, ae, cp.structure_load(head), tops),
                      body_acceleration=vehicle.body_acceleration,
                      body_angular_velocity=vehicle.body_angular_velocity,
-                     wheel_rail=vehicle.wheel_rail, observers=self._observe(ue))
+                     wheel_rail=vehicle.wheel_rail, observers=self._observe(ue), **piles)

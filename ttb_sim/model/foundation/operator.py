@@ -66,6 +66,8 @@ class FoundationOperator:
         plus the cap thickness.
     summary : dict
         What the builder wants reported (DOF counts, reduction, accuracy).
+    pile_rotations : array (3 n_piles, n) or None
+        Rigid rotation of each pile head from q (apply to q' for the rate).
 
     """
 
@@ -79,6 +81,7 @@ class FoundationOperator:
     soil_point_positions: np.ndarray
     depth: float
     summary: dict[str, Any] = field(default_factory=dict)
+    pile_rotations: np.ndarray | None = None
 
     @property
     def size(self) -> int:
