@@ -112,7 +112,7 @@ def test_bearing_forces_on_girders_and_pier_are_equal_and_opposite(spring_piles)
 
 
 def test_partitioned_scheme_decays_after_the_train_has_left(spring_piles):
-    """n dt = 1.5 ms: where the lagged-force scheme blew up, free vibration must decay."""
+    """At n dt = 1.5 ms, where the lagged-force scheme blew up, free vibration decays."""
     long = ['solver.dt=5e-4', 'solver.duration=8.0']
     monolithic = passage(PILED + long + ['solver.coupling=monolithic',
                                          'solver.substructure_steps=1'])
