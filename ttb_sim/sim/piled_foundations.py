@@ -259,3 +259,51 @@ def pile_outputs(structure: Structure, foundations: PiledFoundations, ue: np.nda
                                (op.soil_points @ qa).reshape(-1, 3)]))
     return {'pile_displacement': np.vstack(disp), 'pile_acceleration': np.vstack(acc),
             'pile_rotation_rate': np.vstack(rot), 'soil_points': np.vstack(soil)}
+
+
+class RigidDisplacement:
+    """
+    [P] Eq. 16 beside the computed girder: the mid-span a rigid girder would have.
+
+    A rigid girder on supports that settle as the mean head of their piles
+    has its mid-span at the mean of the two: sum_i U_p,i / 2N for a girder on
+    one piled pier of N piles, the mean of both piers' for a girder on two.
+    The tracker keeps, per span with a piled support, the peaks and the RMS
+    of the estimate and of the computed mid-span displacement (vertical).
+    """
+
+    def __init__(self, structure: Structure) -> None:
+        self.n_spans = structure.girder.n_spans
+        piled = [p.support for p in structure.piled]
+        self.spans = sorted({s - 1 for s in piled} | set(piled))
+        self.spans = [k for k in self.spans if 0 <= k < self.n_spans]
+        counts = [p.operator.n_piles for p in structure.piled]
+        rows = np.split(np.arange(sum(counts)), np.cumsum(counts)[:-1])
+        self._slices = dict(zip(piled, rows))
+        n = len(self.spans)
+        self._peak = np.zeros((2, n))
+        self._sq = np.zeros((3, n))
+        self._frames = 0
+
+    def update(self, midspan: np.ndarray, pile_displacement: np.ndarray) -> None:
+        """Take one frame: mid-span (n_spans, 3) and pile heads (n_piles, 3) displacements."""
+        if not self.spans or pile_displacement.size == 0:
+            return
+        settle = np.zeros(self.n_spans + 1)
+        for support, rows in self._slices.items():
+            settle[support] = pile_displacement[rows, 2].mean()
+        spans = np.asarray(self.spans)
+        estimate = 0.5 * (settle[spans] + settle[spans + 1])
+        computed = midspan[spans, 2]
+        self._peak[0] = np.maximum(self._peak[0], np.abs(estimate))
+        self._peak[1] = np.maximum(self._peak[1], np.abs(computed))
+        self._sq += np.stack([estimate, computed, computed - estimate]) ** 2
+        self._frames += 1
+
+    def summary(self) -> list[dict[str, float]]:
+        """Return per span: girder number and the peaks and RMS values (m)."""
+        rms = np.sqrt(self._sq / max(self._frames, 1))
+        return [{'girder': k + 1, 'rigid_peak': float(self._peak[0, i]),
+                 'computed_peak': float(self._peak[1, i]), 'rigid_rms': float(rms[0, i]),
+                 'computed_rms': float(rms[1, i]), 'difference_rms': float(rms[2, i])}
+                for i, k in enumerate(self.spans)]

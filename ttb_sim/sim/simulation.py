@@ -36,7 +36,7 @@ from ttb_sim.sim.build import (build_coupling, build_structure, build_vehicle, o
 from ttb_sim.sim.cost import CostEstimate, estimate_cost, STEP_BUDGET
 from ttb_sim.sim.frames import Frame, Layout
 from ttb_sim.sim.integrators.newmark import Newmark
-from ttb_sim.sim.piled_foundations import pile_outputs, PiledFoundations
+from ttb_sim.sim.piled_foundations import pile_outputs, PiledFoundations, RigidDisplacement
 from ttb_sim.sim.variants import blas_threads, solver_variant
 
 log = logging.getLogger(__name__)
@@ -139,6 +139,7 @@ class Simulation:
                                            reduced=self.variant.reduced)
         self.foundations = PiledFoundations(st, self.integrator,
                                             scenario.solver.substructure_steps)
+        self.rigid = RigidDisplacement(st)
         self.layout = Layout(n_spans=scenario.bridge.n_spans, n_supports=st.n_supports,
                              n_bodies=self.coupling.n_bodies, n_axles=self.coupling.n_axles,
                              observers=names,
@@ -217,7 +218,20 @@ class Simulation:
 
     def describe(self) -> dict[str, Any]:
         """Return stepping details for ``summary.json`` (the solver section has the rest)."""
-        return {'variant': self.scenario.solver.variant}
+        about: dict[str, Any] = {'variant': self.scenario.solver.variant}
+        st = self.structure
+        if st.piled:
+            solver = self.scenario.solver
+            blocks = sum(p.operator.size for p in st.piled if p.block is not None)
+            about['coupling'] = {'scheme': solver.coupling,
+                                 'substructure_steps': solver.substructure_steps,
+                                 'substructure_dt': self.dt * solver.substructure_steps}
+            about['dofs'] = {'train_track_bridge': st.n_free - blocks,
+                             'piled_piers': {f'pier{p.support + 1:02d}': {
+                                 'coordinates': p.operator.size, **p.operator.summary}
+                                 for p in st.piled}}
+            about['rigid_displacement'] = self.rigid.summary()
+        return about
 
     def auto_duration(self) -> float:
         """Return the time for the last axle to leave the bridge plus free vibration (s)."""
@@ -283,6 +297,8 @@ class Simulation:
         vehicle = cp.vehicle_outputs()
         tops = self.foundations.tops() if self.foundations.active else None
         piles = pile_outputs(st, self.foundations, ue, ve, ae)
+        if piles:
+            self.rigid.update(ue[st.midspan_dofs], piles['pile_displacement'])
         return Frame(step=step, time=step * self.dt, head_position=head, speed=self.speed,
                      midspan=ue[st.midspan_dofs],
                      bearings=bearing_forces(st, ue, ve, ae, cp.structure_load(head), tops),
