@@ -113,28 +113,45 @@ def model_markers(scenario: Scenario) -> list[Box]:
         if s in (0, b.n_spans):
             boxes.append(Box('abutments', s, (x, 0.0, -depth - 1.5), (2.0, width + 1.0, 3.0),
                              ABUTMENT_COLOR))
+        elif s + 1 in scenario.foundation.piled_piers:
+            # as modelled: the column from the bearings (z = 0) down to the cap
+            column = max(height - depth, 0.1)
+            boxes.append(Box('piers', s, (x, 0.0, -depth - column / 2),
+                             (2.0, 0.6 * width, column), PIER_COLOR))
+            boxes.extend(pile_group_markers(scenario, origin=(x, 0.0, -height),
+                                            first_id=100 * s))
         else:
             boxes.append(Box('piers', s, (x, 0.0, -depth - height / 2),
                              (2.0, 0.6 * width, height), PIER_COLOR))
     return boxes
 
 
-def pile_group_markers(scenario: Scenario) -> list[Box]:
+def pile_group_markers(scenario: Scenario, origin: tuple[float, float, float] | None = None,
+                       first_id: int = 0) -> list[Box]:
     """
     Describe a pile-soil substructure: one box per pile, the cap if modelled, the soil block.
 
-    Positions are in the substructure's own axes (ground surface z = 0, block
-    centred on the origin); circular piles are drawn as their equal-area squares.
+    Alone (``origin`` None) the positions are in the substructure's own axes
+    (ground surface z = 0, block centred on the origin). Under a piled pier,
+    ``origin`` is the pier base (the cap top): the group is centred under it
+    and the ground is a cap thickness lower. Circular piles are drawn as their
+    equal-area squares; ids start at ``first_id``.
     """
     piles, soil, cap = scenario.piles, scenario.soil, scenario.cap
+    if origin is None:
+        ox, oy, oz = 0.0, 0.0, 0.0
+    else:  # the pier stands on the group centre, the cap on the ground
+        ox, oy = origin[0] - piles.centre[0], origin[1] - piles.centre[1]
+        oz = origin[2] - cap.thickness
     w = piles.width
-    boxes = [Box('piles', i, (x, y, -piles.length / 2), (w, w, piles.length), PILE_COLOR)
+    boxes = [Box('piles', first_id + i, (ox + x, oy + y, oz - piles.length / 2),
+                 (w, w, piles.length), PILE_COLOR)
              for i, (x, y) in enumerate(piles.centres())]
     if cap.enabled:
         cx, cy = piles.centre
-        boxes.append(Box('cap', 0, (cx, cy, cap.thickness / 2), (cap.lx, cap.ly, cap.thickness),
-                         CAP_COLOR))
-    boxes.append(Box('soil', 0, (0.0, 0.0, -soil.depth / 2),
+        boxes.append(Box('cap', first_id, (ox + cx, oy + cy, oz + cap.thickness / 2),
+                         (cap.lx, cap.ly, cap.thickness), CAP_COLOR))
+    boxes.append(Box('soil', first_id, (ox, oy, oz - soil.depth / 2),
                      (soil.block.lx, soil.block.ly, soil.depth), SOIL_COLOR))
     return boxes
 
