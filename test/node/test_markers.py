@@ -51,3 +51,23 @@ def test_a_pile_group_is_drawn_instead_of_the_bridge():
     (soil,) = [b for b in full.boxes if b.ns == 'soil']
     assert soil.size == pytest.approx((36.0, 30.0, 22.0)) and soil.position[2] == -11.0
     assert [b.ns for b in full.boxes].count('cap') == 1
+
+
+def test_piled_piers_stand_on_their_pile_groups():
+    scenario = load_scenario('paper_ttbcpsi')
+    boxes = model_markers(scenario)
+    piles = [b for b in boxes if b.ns == 'piles']
+    caps = [b for b in boxes if b.ns == 'cap']
+    soils = [b for b in boxes if b.ns == 'soil']
+    assert len(piles) == 30 and len(caps) == 2 and len(soils) == 2
+    ids = [(b.ns, b.marker_id) for b in boxes]
+    assert len(ids) == len(set(ids))
+    height, cap = scenario.piers.height, scenario.cap.thickness
+    for support, cap_box in zip((7, 8), caps):
+        x = (support - 1) * scenario.bridge.span_length
+        # the cap top carries the pier base (z = -height), centred under the pier
+        assert cap_box.position == pytest.approx((x, 0.0, -height - cap / 2))
+        group = [b for b in piles if abs(b.position[0] - x) < 10.0]
+        assert len(group) == 15
+        assert max(b.position[2] + b.size[2] / 2 for b in group) == pytest.approx(-height - cap)
+    assert [b.ns for b in boxes].count('piers') == 9
