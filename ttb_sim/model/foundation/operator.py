@@ -32,7 +32,7 @@ pile-soil model. The bridge attaches it through its bearings only.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Any
+from typing import Any, Optional
 
 import numpy as np
 
@@ -41,6 +41,44 @@ from ttb_sim.fe.beam import BeamSection, global_matrices, NODE_DOFS
 
 TOP = np.arange(NODE_DOFS)
 """Indices of the pier-top DOFs in q (always the first six)."""
+
+
+@dataclass(frozen=True)
+class InterfaceRows:
+    """
+    The pile-soil interface of a linear substructure, at its Gauss points, from q.
+
+    The reduced model keeps the Desai interface at its initial (geostatic)
+    tangent; these rows give the tractions that tangent implies, and the
+    Mohr-Coulomb strength they are to be compared with, so that a run can show
+    the interface stayed in its initial, linear range (see
+    :func:`~.reduction.interface_mobilisation`).
+
+    Attributes
+    ----------
+    normal : array (g, n)
+        Normal traction increment from the geostatic state (Pa, tension
+        positive) at each of the g Gauss points, from q.
+    shear : array (2 g, n)
+        The two shear tractions (Pa) per Gauss point, point-major, from q.
+    sigma_n0 : array (g,)
+        Geostatic normal compression (Pa).
+    cohesion, tan_delta : arrays (g,)
+        Adhesion c (Pa) and friction coefficient tan(delta): the strength is
+        c + (sigma_n0 - normal) tan(delta).
+
+    """
+
+    normal: np.ndarray
+    shear: np.ndarray
+    sigma_n0: np.ndarray
+    cohesion: np.ndarray
+    tan_delta: np.ndarray
+
+    @property
+    def n_points(self) -> int:
+        """Number of Gauss points g."""
+        return int(self.normal.shape[0])
 
 
 @dataclass(frozen=True)
@@ -68,6 +106,8 @@ class FoundationOperator:
         What the builder wants reported (DOF counts, reduction, accuracy).
     pile_rotations : array (3 n_piles, n) or None
         Rigid rotation of each pile head from q (apply to q' for the rate).
+    interface : InterfaceRows or None
+        Pile-soil interface tractions and strength from q (None: no interface).
 
     """
 
@@ -82,6 +122,7 @@ class FoundationOperator:
     depth: float
     summary: dict[str, Any] = field(default_factory=dict)
     pile_rotations: np.ndarray | None = None
+    interface: Optional[InterfaceRows] = None
 
     @property
     def size(self) -> int:

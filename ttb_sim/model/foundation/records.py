@@ -149,6 +149,42 @@ class MeshSize:
 
 
 @dataclass(frozen=True)
+class ReductionParameters:
+    """
+    Reduced-order model of a piled pier for the coupled run (``soil.reduction``).
+
+    The soil-pile-cap interior is replaced by the static modes of the cap-top
+    master plus second-order block Krylov vectors of the master loads at real
+    shifts s = 2 pi f (see :mod:`.reduction`): up to 6 vectors per level and
+    shift.
+    """
+
+    shifts: tuple[float, ...] = param(
+        (0.0, 15.0), 'Hz', 'Real expansion points f of the Krylov vectors (shift s = 2 pi f '
+        'of the pencil K + s C + s^2 M); 0 = about the static solution.', low=0.0,
+        high=1000.0)
+    shift_axis: str = param('real', '-', "Where the shifts lie: 'imaginary' = s = i 2 pi "
+                            'f, the complex pencil K - w^2 M + i w C factorised by LDL^T of its '
+                            "real 2n form; 'real' = s = 2 pi f, the positive definite K + s C + "
+                            's^2 M (Cholesky).', choices=('imaginary', 'real'))
+    levels: int = param(8, '-', 'Krylov levels per shift (each adds up to 6 vectors).',
+                        low=1, high=100)
+    tolerance: float = param(1e-9, '-', 'Deflation: a new direction is dropped when its '
+                             'part outside the basis is below this fraction of its norm.',
+                             low=0.0, high=0.1, low_inclusive=False)
+
+    def __post_init__(self) -> None:
+        """Check every field against its declaration, and one shift at least, all distinct."""
+        check_declared(self, 'soil.reduction.', FoundationError)
+        if not self.shifts or len(set(self.shifts)) != len(self.shifts):
+            raise FoundationError(f'soil.reduction.shifts = {list(self.shifts)!r}; allowed: '
+                                  'one or more distinct frequencies in [0, 1000] Hz')
+        if not all(math.isfinite(f) and 0.0 <= f <= 1000.0 for f in self.shifts):
+            raise FoundationError(f'soil.reduction.shifts = {list(self.shifts)!r}; allowed: '
+                                  'one or more distinct frequencies in [0, 1000] Hz')
+
+
+@dataclass(frozen=True)
 class SoilParameters:
     """The layered soil block: layers, plan size, mesh and boundary (``soil``)."""
 
@@ -158,6 +194,7 @@ class SoilParameters:
         "default: [P] Table 5's three layers.")
     block: BlockSize = field(default_factory=BlockSize)
     mesh: MeshSize = field(default_factory=MeshSize)
+    reduction: ReductionParameters = field(default_factory=ReductionParameters)
     boundary: str = param('viscoelastic', '-', "Sides and base: 'viscoelastic' = springs "
                           'alpha G / R and dashpots rho Vs, rho Vp per unit area ([P] Eq. 3, R '
                           "from the group centre); 'lysmer' = the dashpots only; 'fixed' = "
