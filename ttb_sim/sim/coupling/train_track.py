@@ -51,6 +51,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 import logging
 import math
+from typing import Any, Callable
 
 import numpy as np
 
@@ -65,6 +66,7 @@ from ttb_sim.model.vehicle.matrices import gyroscopic_matrix, train_matrices
 import ttb_sim.model.wheel_rail as ct
 from ttb_sim.model.wheel_rail.parameters import ContactParameters
 from ttb_sim.model.wheel_rail.profiles import contact_geometry_table, ContactGeometryTable
+from ttb_sim.sim import kernels
 from ttb_sim.sim.coupling.base import VehicleOutputs
 from ttb_sim.sim.integrators.protocol import Integrator
 from ttb_sim.sim.lean import point_rows_and_slopes
@@ -99,6 +101,27 @@ class ContactState:
     """(n_cars, 8) Hertz compression (m)."""
     iterations: int
     """Newton iterations of the step (all cars)."""
+
+
+@dataclass(frozen=True)
+class ContactKernels:
+    """The compiled kernels of the contact step (:mod:`ttb_sim.sim.contact_kernels`)."""
+
+    rail_rows: Callable[..., Any]
+    rail_values: Callable[..., Any]
+    rail_load: Callable[..., Any]
+    contact_newton: Callable[..., Any]
+
+    @classmethod
+    def load(cls) -> ContactKernels | None:
+        """Return the compiled kernels, or None without numba (the numpy step runs)."""
+        found = []
+        for name in ('rail_rows', 'rail_values', 'rail_load', 'contact_newton'):
+            kernel = kernels.compiled(name)
+            if kernel is None:
+                return None
+            found.append(kernel)
+        return cls(*found)
 
 
 class RailCompliance:
@@ -232,6 +255,10 @@ class TrainTrackCoupling:
         self._rail_y = np.zeros((n, 8))
         self._rail_offset = np.zeros((n, 8, COMPONENTS))
         self._wheelset_y = 6 * np.repeat(np.arange(3, 7), 2) + 1
+        self._kernels = ContactKernels.load() if getattr(integrator, 'lean', False) else None
+        """The compiled contact step (lean variants with numba), else None (numpy step)."""
+        self._zero = np.zeros(n_free)
+        self._work: dict[str, np.ndarray] = {}
 
     def _rail_compliance(self, integrator: Integrator,
                          full_to_free: np.ndarray) -> RailCompliance:
@@ -420,6 +447,13 @@ class TrainTrackCoupling:
     # -- one step -------------------------------------------------------------------------
     def step(self, head: float, speed: float) -> None:
         """Advance train, track and bridge together to the head position ``head``."""
+        if self._kernels is not None:
+            self._step_compiled(head, speed, self._kernels)
+        else:
+            self._step_numpy(head, speed)
+
+    def _step_numpy(self, head: float, speed: float) -> None:
+        """Take the step with numpy (the reference path, and the lean path without numba)."""
         self._update_speed(speed)
         nm, n = self.nm, self.n_cars
         n_free = self.n_free
@@ -575,6 +609,130 @@ class TrainTrackCoupling:
         self.force = g3
         self.compression = delta
         self._rail_y = r_exact[..., 1]
+        self.saturation = eps
+        self.iterations = total_iter
+
+    def _buffer(self, name: str, shape: tuple[int, ...], dtype: Any = float) -> np.ndarray:
+        """Return a work array of the compiled step, reallocated when its shape changes."""
+        buf = self._work.get(name)
+        if buf is None or buf.shape != shape:
+            buf = self._work[name] = np.zeros(shape, dtype=dtype)
+        return buf
+
+    def _geometry_tables(self) -> tuple[np.ndarray, ...]:
+        """Return the profile table's columns for the compiled step (empty: the cone)."""
+        table = self.table
+        if table is None:
+            return np.zeros(0), np.zeros((0, 2)), np.zeros((0, 2)), np.zeros(0), np.zeros(0)
+        return tuple(np.ascontiguousarray(c, dtype=float) for c in (
+            table.lateral, table.rolling_radius, table.contact_angle, table.rise, table.roll))
+
+    def _step_compiled(self, head: float, speed: float, k: ContactKernels) -> None:
+        """
+        Take the step with the compiled kernels: the numpy step's formulas, in loops.
+
+        The rail rows, the local compliance, the Newton iteration of the contact
+        laws and the rail loads and responses run compiled
+        (:mod:`ttb_sim.sim.contact_kernels`); the track solves, the train's
+        small dense products and the irregularity stay as in :meth:`_step_numpy`.
+        """
+        self._update_speed(speed)
+        nm, n = self.nm, self.n_cars
+        n_free = self.n_free
+        m = 8 * COMPONENTS
+        x = head + self.contact_x
+        rows = self._buffer('rows', (n, 8, 3, 12))
+        slope = self._buffer('slope', (n, 8, 3, 12))
+        dofs = self._buffer('dofs', (n, 8, 12), np.intp)
+        dr = self._buffer('dr', (n, 8, 3, 3))
+        ds = self._buffer('ds', (n, 8, 3, 3))
+        left, right = self.rails
+        off = k.rail_rows(x, self.side, left.start, left.length, self.rail_dofs[0],
+                          self.compliance.blocks[0], right.start, right.length,
+                          self.rail_dofs[1], self.compliance.blocks[1],
+                          float(self.head_arm[2]), rows, slope, dofs, dr, ds)
+        if off >= 0:
+            raise DivergenceError('a wheel ran off the modelled track at x = '
+                                  f'{x.flat[off]:.2f} m; the run is longer than '
+                                  'the track (check solver.duration)')
+        irr_z, irr_y, irr_dy = self._irregularity(x)
+
+        # Predictors (no contact force).
+        zero = self._zero if self._zero.shape[0] == n_free else np.zeros(n_free)
+        h_v, h_a = nm.history(self.u, self.v, self.a)
+        u_star = nm.solve(nm.effective_load(zero, h_v, h_a))
+        r_star = np.empty((n, 8, 3))
+        rs_star = np.empty((n, 8, 3))
+        r_hist = np.empty((n, 8, 3))
+        k.rail_values(rows, u_star, dofs, r_star)
+        k.rail_values(slope, u_star, dofs, rs_star)
+        k.rail_values(rows, h_v, dofs, r_hist)
+        a0, a1 = nm.a0, nm.a1
+        qh_v = -a1 * self.q - self.qv
+        qh_a = -a0 * self.q - 2.0 * a1 * self.qv - self.qa
+        rhs_t = self.gravity - qh_a @ self.mass.T - qh_v @ self.train_damping.T
+        q_star = rhs_t @ self.a_inv.T
+        w0 = q_star @ self.h.T
+        wv0 = a1 * w0 + qh_v @ self.h.T
+        normal = np.maximum(self.force[..., 2], 0.0)
+        f11, f22, f23, f33 = (np.ascontiguousarray(np.broadcast_to(f, (n, 8))) for f in
+                              ct.scale_creep_coefficients(self.creep0, self.p0, normal))
+        r0p = np.zeros((n, 8, COMPONENTS))
+        r0p[..., :3] = r_star
+        rv0 = np.zeros((n, 8, COMPONENTS))
+        rv0[..., :3] = a1 * r_star + r_hist + speed * rs_star
+        rvel = a1 * dr + speed * ds
+        offset = self._rail_offset.copy()
+        y_star = np.ascontiguousarray(q_star[:, self._wheelset_y])
+        ey = np.ascontiguousarray(self.ey)
+        lateral, radius_table, angle_table, rise, roll = self._geometry_tables()
+        g = self.force.reshape(n, m).copy()
+        y_rel = np.empty((n, 8))
+        delta = np.empty((n, 8))
+        eps = np.empty((n, 8))
+        load = self._buffer('load', (n_free + 1,))
+        r_exact = np.empty((n, 8, 3))
+        total_iter = 0
+        for _outer in range(self.max_iter):
+            rp = (r0p + offset).reshape(n, m)
+            rvp = (rv0 + a1 * offset).reshape(n, m)
+            iterations, change = k.contact_newton(
+                g, w0, wv0, rp, rvp, self.dw, dr, rvel, ey, y_star, irr_y, irr_z, irr_dy,
+                self.side, f11, f22, f23, f33, lateral, radius_table, angle_table, rise, roll,
+                float(self.params.contact_semi_distance), float(self.contact.conicity),
+                float(self.r0), self.g_hertz, float(self.friction), a1, float(speed),
+                GEOMETRY_STEP, float(self.tol), int(self.max_iter), y_rel, delta, eps)
+            total_iter += iterations
+            if not change < self.tol:
+                raise DivergenceError(f'contact iteration did not converge in {self.max_iter} '
+                                      f'iterations (last change {change:.3g} m)')
+            # Exact track response to these forces.
+            k.rail_load(rows, g, dofs, load)
+            u_new = u_star + nm.solve(load[:n_free])
+            k.rail_values(rows, u_new, dofs, r_exact)
+            gx = g.reshape(n, 8, COMPONENTS)[..., :3]
+            r_model = rp.reshape(n, 8, COMPONENTS)[..., :3] - np.einsum('cwij,cwj->cwi', dr, gx)
+            mismatch = r_exact - r_model
+            if np.max(np.abs(mismatch[..., 2])) <= self.tol:
+                break
+            offset[..., :3] += mismatch
+        else:
+            raise DivergenceError('rail displacement under the wheels did not converge to '
+                                  f'contact.tolerance = {self.tol:g} m')
+
+        self._check_flange(y_rel)
+        self._rail_offset = offset
+        self._rail_offset[..., :3] += mismatch
+        # Accept the step.
+        q_new = q_star + (g @ self.h) @ self.a_inv.T
+        self.qv = a1 * q_new + qh_v
+        self.qa = a0 * q_new + qh_a
+        self.q = q_new
+        self.v, self.a = nm.finish(u_new, h_v, h_a)
+        self.u = u_new
+        self.force = g.reshape(n, 8, COMPONENTS)
+        self.compression = delta
+        self._rail_y = r_exact[..., 1].copy()
         self.saturation = eps
         self.iterations = total_iter
 
