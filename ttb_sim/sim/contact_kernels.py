@@ -27,6 +27,8 @@ uncompiled they are correct but slow.
   local compliance of the rail under the wheel (rows B rows^T, B the element's
   block of the inverse effective track matrix).
 * :func:`rail_values`: rail-head motion under the wheels from a track vector.
+* :func:`rail_predictor`: the same of K^-1 rhs from the local columns of K^-1
+  (the single-solve step).
 * :func:`rail_load`: the track load of the wheel forces.
 * :func:`contact_newton`: the Newton iteration of the contact laws of every
   car (Hertz, contact geometry, Kalker's creep saturated by Shen-Hedrick-Elkins)
@@ -73,7 +75,7 @@ def rail_rows(x: np.ndarray, side: np.ndarray, start_l: np.ndarray, length_l: np
               dofs_l: np.ndarray, blocks_l: np.ndarray, start_r: np.ndarray,
               length_r: np.ndarray, dofs_r: np.ndarray, blocks_r: np.ndarray, arm: float,
               rows: np.ndarray, slope: np.ndarray, dofs: np.ndarray, dr: np.ndarray,
-              ds: np.ndarray) -> int:
+              ds: np.ndarray, element: np.ndarray) -> int:
     """
     Fill the rail-head rows under every wheel and the local rail compliance.
 
@@ -95,6 +97,8 @@ def rail_rows(x: np.ndarray, side: np.ndarray, start_l: np.ndarray, length_l: np
         Out, (n, 8, 12) extended free DOFs of those elements.
     dr, ds : numpy.ndarray
         Out, (n, 8, 3, 3): rows B rows^T and slope B rows^T.
+    element : numpy.ndarray
+        Out, (n, 8) the rail element under each wheel.
 
     Returns
     -------
@@ -123,6 +127,7 @@ def rail_rows(x: np.ndarray, side: np.ndarray, start_l: np.ndarray, length_l: np
             if not (local >= 0.0 and local <= el * (1 + 1e-12)):
                 return c * n_wheels + k
             xi = min(max(local / el, 0.0), 1.0)
+            element[c, k] = e
             for d in range(3):
                 _hermite(xi, el, d, h[d])
             for order in range(2):
@@ -195,6 +200,56 @@ def rail_load(rows: np.ndarray, g: np.ndarray, dofs: np.ndarray, out: np.ndarray
                 for i in range(3):
                     acc += rows[c, k, i, j] * g[c, COMPONENTS * k + i]
                 out[dofs[c, k, j]] -= acc
+
+
+def rail_predictor(element: np.ndarray, side: np.ndarray, start_l: np.ndarray,
+                   dofs_l: np.ndarray, values_l: np.ndarray, start_r: np.ndarray,
+                   dofs_r: np.ndarray, values_r: np.ndarray, rows: np.ndarray,
+                   slope: np.ndarray, rhs: np.ndarray, r_out: np.ndarray,
+                   rs_out: np.ndarray) -> None:
+    """
+    Fill the rail-head motion and slope under the wheels of K^-1 rhs, from local columns.
+
+    Parameters
+    ----------
+    element, side : numpy.ndarray
+        (n, 8) rail element under each wheel and the wheel's side (+1 left rail).
+    start_l, dofs_l, values_l, start_r, dofs_r, values_r : numpy.ndarray
+        Per rail: node i's K^-1 columns (its 6 DOFs) are ``values[start[i]:start[i + 1]]``
+        ((nnz, 6)) on the free DOFs ``dofs[start[i]:start[i + 1]]``.
+    rows, slope : numpy.ndarray
+        (n, 8, 3, 12) rail-head rows and slopes.
+    rhs : numpy.ndarray
+        (n_free,) the right-hand side.
+    r_out, rs_out : numpy.ndarray
+        Out, (n, 8, 3).
+
+    """
+    n_cars, n_wheels = element.shape
+    zb = np.empty(12)
+    for c in range(n_cars):
+        for k in range(n_wheels):
+            if side[c, k] > 0:
+                start, dofs, values = start_l, dofs_l, values_l
+            else:
+                start, dofs, values = start_r, dofs_r, values_r
+            e = element[c, k]
+            for a in range(2):
+                node = e + a
+                for d in range(6):
+                    zb[6 * a + d] = 0.0
+                for t in range(start[node], start[node + 1]):
+                    value = rhs[dofs[t]]
+                    for d in range(6):
+                        zb[6 * a + d] += values[t, d] * value
+            for i in range(3):
+                acc = 0.0
+                acc_s = 0.0
+                for j in range(12):
+                    acc += rows[c, k, i, j] * zb[j]
+                    acc_s += slope[c, k, i, j] * zb[j]
+                r_out[c, k, i] = acc
+                rs_out[c, k, i] = acc_s
 
 
 def _interp(y: float, grid: np.ndarray, j: int, column: np.ndarray) -> float:

@@ -124,4 +124,5 @@ def _finish(u: np.ndarray, a0: float, a1: float, h_v: np.ndarray,
 _KERNELS: dict[str, Callable[..., Any]] = {
     'moving_load': _moving_load, 'history': _history, 'finish': _finish,
     'rail_rows': contact_kernels.rail_rows, 'rail_values': contact_kernels.rail_values,
-    'rail_load': contact_kernels.rail_load, 'contact_newton': contact_kernels.contact_newton}
+    'rail_load': contact_kernels.rail_load, 'contact_newton': contact_kernels.contact_newton,
+    'rail_predictor': contact_kernels.rail_predictor}

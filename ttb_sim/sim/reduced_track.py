@@ -322,7 +322,7 @@ class ReducedTrainTrackCoupling(TrainTrackCoupling):
         self.n_free = window.size
         ftr = window.full_to_reduced
         self.rail_dofs = tuple(ftr[r.dofs] for r in self.rails)
-        self.compliance = RailCompliance(self.nm, self.rails, ftr)
+        self.compliance = RailCompliance(self.nm, self.rails, ftr, self.influence_hops)
         self.u, self.v, self.a = (s[window.kept].copy() for s in state)
         self.window = window
         self.window_moves += 1
