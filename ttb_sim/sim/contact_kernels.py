@@ -30,6 +30,7 @@ uncompiled they are correct but slow.
 * :func:`rail_predictor`: the same of K^-1 rhs from the local columns of K^-1
   (the single-solve step).
 * :func:`rail_load`: the track load of the wheel forces.
+* :func:`rail_irregularity`: the rail irregularity under the wheels.
 * :func:`contact_newton`: the Newton iteration of the contact laws of every
   car (Hertz, contact geometry, Kalker's creep saturated by Shen-Hedrick-Elkins)
   on the local track model; per car 32 unknowns and one dense 32 x 32 solve
@@ -250,6 +251,53 @@ def rail_predictor(element: np.ndarray, side: np.ndarray, start_l: np.ndarray,
                     acc_s += slope[c, k, i, j] * zb[j]
                 r_out[c, k, i] = acc
                 rs_out[c, k, i] = acc_s
+
+
+def rail_irregularity(x: np.ndarray, side: np.ndarray, x_start: float, dx: float,
+                      values: np.ndarray, slopes: np.ndarray, curvatures: np.ndarray,
+                      slack: float, z: np.ndarray, y: np.ndarray, dy: np.ndarray) -> None:
+    """
+    Fill the vertical and lateral irregularity and lateral slope of each wheel's rail.
+
+    The quintic Hermite interpolation of :meth:`TrackIrregularity.sample` on the
+    grid (x_start, dx) of ``values``, ``slopes``, ``curvatures`` ((4, N): z_left,
+    z_right, y_left, y_right); zero outside the grid (beyond ``slack`` grid steps).
+    """
+    last = values.shape[1] - 1
+    n_cars, n_wheels = x.shape
+    for c in range(n_cars):
+        for k in range(n_wheels):
+            s = (x[c, k] - x_start) / dx
+            if not (s >= -slack and s <= last + slack):
+                z[c, k] = 0.0
+                y[c, k] = 0.0
+                dy[c, k] = 0.0
+                continue
+            i = int(min(max(math.floor(s), 0), last - 1))
+            t = s - i
+            left = side[c, k] > 0
+            for q in range(2):
+                row = (0 if left else 1) if q == 0 else (2 if left else 3)
+                p0 = values[row, i]
+                p1 = values[row, i + 1]
+                m0 = dx * slopes[row, i]
+                m1 = dx * slopes[row, i + 1]
+                c0 = dx * dx * curvatures[row, i]
+                c1 = dx * dx * curvatures[row, i + 1]
+                a2 = 0.5 * c0
+                d0 = p1 - (p0 + m0 + a2)
+                d1 = m1 - (m0 + c0)
+                d2 = c1 - c0
+                a3 = 10.0 * d0 - 4.0 * d1 + 0.5 * d2
+                a4 = -15.0 * d0 + 7.0 * d1 - d2
+                a5 = 6.0 * d0 - 3.0 * d1 + 0.5 * d2
+                value = p0 + t * (m0 + t * (a2 + t * (a3 + t * (a4 + t * a5))))
+                if q == 0:
+                    z[c, k] = value
+                else:
+                    y[c, k] = value
+                    dy[c, k] = (m0 + t * (2.0 * a2 + t * (3.0 * a3 + t * (
+                        4.0 * a4 + t * 5.0 * a5)))) / dx
 
 
 def _interp(y: float, grid: np.ndarray, j: int, column: np.ndarray) -> float:

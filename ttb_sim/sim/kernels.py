@@ -125,4 +125,5 @@ _KERNELS: dict[str, Callable[..., Any]] = {
     'moving_load': _moving_load, 'history': _history, 'finish': _finish,
     'rail_rows': contact_kernels.rail_rows, 'rail_values': contact_kernels.rail_values,
     'rail_load': contact_kernels.rail_load, 'contact_newton': contact_kernels.contact_newton,
-    'rail_predictor': contact_kernels.rail_predictor}
+    'rail_predictor': contact_kernels.rail_predictor,
+    'rail_irregularity': contact_kernels.rail_irregularity}

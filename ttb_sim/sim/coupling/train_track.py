@@ -60,6 +60,7 @@ from ttb_sim.errors import DivergenceError, ModelError
 from ttb_sim.fe.factorization import factorize
 from ttb_sim.model.bridge import Structure
 from ttb_sim.model.irregularity import TrackIrregularity
+from ttb_sim.model.irregularity._checks import GRID_SLACK
 from ttb_sim.model.track import BeamLine
 from ttb_sim.model.vehicle.car import CarParameters
 from ttb_sim.model.vehicle.dofs import dofs as car_dofs
@@ -126,13 +127,14 @@ class ContactKernels:
     rail_load: Callable[..., Any]
     contact_newton: Callable[..., Any]
     rail_predictor: Callable[..., Any]
+    rail_irregularity: Callable[..., Any]
 
     @classmethod
     def load(cls) -> ContactKernels | None:
         """Return the compiled kernels, or None without numba (the numpy step runs)."""
         found = []
         for name in ('rail_rows', 'rail_values', 'rail_load', 'contact_newton',
-                     'rail_predictor'):
+                     'rail_predictor', 'rail_irregularity'):
             kernel = kernels.compiled(name)
             if kernel is None:
                 return None
@@ -175,10 +177,10 @@ class RailCompliance:
             dofs = full_to_free[rail.dofs]                     # (n_el, 12)
             nodes = np.vstack([dofs[:, :6], dofs[-1:, 6:]])    # (n_nodes, 6)
             n_nodes = nodes.shape[0]
-            near = np.zeros((n_nodes, 0), dtype=np.intp)
+            columns = _Columns(n_nodes)
+            reach = sp.csc_matrix((n_free, n_nodes))
             if influence_hops is not None:
-                near = neighbourhoods(integrator, nodes, influence_hops)
-                values = np.zeros((n_nodes, 6, near.shape[1]))
+                reach = neighbourhoods(integrator, nodes, influence_hops)
             # cols[i, j, :] = K^-1 column of node i, DOF j, restricted to nodes i-1..i+1.
             local = np.zeros((n_nodes, 6, 3, 6))
             for offset in range(spacing):
@@ -188,7 +190,8 @@ class RailCompliance:
                     rhs[nodes[probe, j], j] = 1.0
                 sol = np.vstack([integrator.solve(rhs[:n_free]), np.zeros((1, 6))])
                 if influence_hops is not None:
-                    values[probe] = sol[near[probe]].transpose(0, 2, 1)
+                    for p in probe:
+                        columns.add(p, reach.indices[reach.indptr[p]:reach.indptr[p + 1]], sol)
                 for k, shift in enumerate((-1, 0, 1)):
                     at = np.clip(probe + shift, 0, n_nodes - 1)
                     local[probe, :, k, :] = sol[nodes[at]].transpose(0, 2, 1)
@@ -202,26 +205,36 @@ class RailCompliance:
             b[:, 6:, 6:] = local[e + 1, :, 1, :].transpose(0, 2, 1)
             self.blocks.append(0.5 * (b + b.transpose(0, 2, 1)))
             if influence_hops is not None:
-                self.influence.append(_ragged(near, values, n_free))
+                self.influence.append(columns.arrays())
 
 
-def _ragged(near: np.ndarray, values: np.ndarray,
-            n_free: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Keep each node's entries above INFLUENCE_DROP of its largest, one after the other."""
-    peak = np.abs(values).max(axis=(1, 2))
-    keep = (np.abs(values) >= INFLUENCE_DROP * peak[:, None, None]).any(axis=1)
-    keep &= near < n_free
-    start = np.concatenate([[0], np.cumsum(keep.sum(axis=1))]).astype(np.intp)
-    node, slot = np.nonzero(keep)
-    return start, near[node, slot], np.ascontiguousarray(values[node, :, slot])
+class _Columns:
+    """Each rail node's K^-1 columns on its neighbourhood, the small entries dropped."""
+
+    def __init__(self, n_nodes: int) -> None:
+        self._dofs: list[np.ndarray] = [np.zeros(0, dtype=np.intp)] * n_nodes
+        self._values: list[np.ndarray] = [np.zeros((0, 6))] * n_nodes
+
+    def add(self, node: int, near: np.ndarray, solution: np.ndarray) -> None:
+        """Keep the probe solution (n_free + 1, 6) of ``node`` on its DOFs ``near``."""
+        values = solution[near]
+        keep = np.any(np.abs(values) >= INFLUENCE_DROP * np.abs(values).max(), axis=1)
+        self._dofs[node] = near[keep].astype(np.intp)
+        self._values[node] = values[keep]
+
+    def arrays(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Return (start (n_nodes + 1,), DOFs (nnz,), values (nnz, 6)), node after node."""
+        counts = [d.size for d in self._dofs]
+        start = np.concatenate([[0], np.cumsum(counts)]).astype(np.intp)
+        return (start, np.concatenate(self._dofs),
+                np.ascontiguousarray(np.concatenate(self._values)))
 
 
-def neighbourhoods(integrator: Integrator, nodes: np.ndarray, hops: int) -> np.ndarray:
+def neighbourhoods(integrator: Integrator, nodes: np.ndarray, hops: int) -> sp.csc_matrix:
     """
-    Return the free DOFs within ``hops`` couplings of each node, (n_nodes, width).
+    Return the free DOFs within ``hops`` couplings of each node: column i holds node i's.
 
-    Couplings are the non-zeros of the effective matrix (K, C, M); rows are
-    padded with ``n_free`` (the ground slot), as are constrained DOFs.
+    Couplings are the non-zeros of the effective matrix (K, C, M).
     """
     n_free = integrator.mass.shape[0]
     pattern = (abs(integrator.stiffness) + abs(integrator.damping)
@@ -237,12 +250,7 @@ def neighbourhoods(integrator: Integrator, nodes: np.ndarray, hops: int) -> np.n
         reach.data[:] = 1.0
     reach = reach.tocsc()
     reach.sort_indices()
-    counts = np.diff(reach.indptr)
-    width = int(counts.max()) if n_nodes else 0
-    near = np.full((n_nodes, width), n_free, dtype=np.intp)
-    for i in range(n_nodes):
-        near[i, :counts[i]] = reach.indices[reach.indptr[i]:reach.indptr[i + 1]]
-    return near
+    return reach
 
 
 class TrainTrackCoupling:
@@ -337,7 +345,7 @@ class TrainTrackCoupling:
         self._wheelset_y = 6 * np.repeat(np.arange(3, 7), 2) + 1
         self._slope_offset = np.zeros((n, 8, 3))
         self.solves = 0
-        """Track solves of the last step (the compiled step counts them)."""
+        """Track solves of the last step."""
         self._zero = np.zeros(n_free)
         self._work: dict[str, np.ndarray] = {}
 
@@ -693,6 +701,7 @@ class TrainTrackCoupling:
         self._rail_y = r_exact[..., 1]
         self.saturation = eps
         self.iterations = total_iter
+        self.solves = _outer + 2
 
     def _buffer(self, name: str, shape: tuple[int, ...], dtype: Any = float) -> np.ndarray:
         """Return a work array of the compiled step, reallocated when its shape changes."""
@@ -748,7 +757,11 @@ class TrainTrackCoupling:
             raise DivergenceError('a wheel ran off the modelled track at x = '
                                   f'{x.flat[off]:.2f} m; the run is longer than '
                                   'the track (check solver.duration)')
-        irr_z, irr_y, irr_dy = self._irregularity(x)
+        irr_z, irr_y, irr_dy = np.zeros((n, 8)), np.zeros((n, 8)), np.zeros((n, 8))
+        irr = self.irregularity
+        if irr is not None:
+            k.rail_irregularity(x, self.side, float(irr.x_start), float(irr.dx), irr.values,
+                                irr.slopes, irr.curvatures, GRID_SLACK, irr_z, irr_y, irr_dy)
 
         # Predictors (no contact force).
         single = bool(self.compliance.influence)
