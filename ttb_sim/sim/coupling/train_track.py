@@ -190,8 +190,9 @@ class RailCompliance:
                     rhs[nodes[probe, j], j] = 1.0
                 sol = np.vstack([integrator.solve(rhs[:n_free]), np.zeros((1, 6))])
                 if influence_hops is not None:
-                    for p in probe:
-                        columns.add(p, reach.indices[reach.indptr[p]:reach.indptr[p + 1]], sol)
+                    for p in probe.tolist():
+                        near = reach.indices[reach.indptr[p]:reach.indptr[p + 1]]
+                        columns.add(p, near, sol)
                 for k, shift in enumerate((-1, 0, 1)):
                     at = np.clip(probe + shift, 0, n_nodes - 1)
                     local[probe, :, k, :] = sol[nodes[at]].transpose(0, 2, 1)
