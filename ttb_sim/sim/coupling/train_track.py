@@ -44,6 +44,15 @@ the rail displacement under every wheel is compared with the local prediction;
 any mismatch above ``contact.tolerance`` is fed back and the iteration
 repeated, so each step's contact forces satisfy the contact laws on the exact
 track response to that tolerance.
+
+The lean solver variants take the same step compiled when numba is installed
+(:mod:`ttb_sim.sim.contact_kernels`) and solve the track once per step instead
+of twice: the predictor's rail motion under the wheels comes from each rail
+node's K^-1 columns on the DOFs near it (probed once, with the compliance
+blocks), the contact is iterated on it and the track solved for predictor and
+contact loads together; the exact rail motion then corrects the offsets as
+above, and the step is accepted when all three components agree to the
+tolerance. ``reference`` keeps the numpy step with two solves.
 """
 
 from __future__ import annotations
