@@ -24,9 +24,12 @@ which computes the same numbers. The kernels are compiled on first use
 from __future__ import annotations
 
 import logging
+import sys
 from typing import Any, Callable
 
 import numpy as np
+
+from ttb_sim.sim import contact_kernels
 
 log = logging.getLogger(__name__)
 
@@ -51,8 +54,19 @@ def compiled(name: str) -> Callable[..., Any] | None:
             log.debug('numba is not installed; the lean step runs its numpy twins')
             _CACHE[name] = None
         else:
-            _CACHE[name] = numba.njit(cache=True, nogil=True)(_KERNELS[name])
+            kernel = _KERNELS[name]
+            _jit_helpers(numba, kernel)
+            _CACHE[name] = numba.njit(cache=True, nogil=True)(kernel)
     return _CACHE[name]
+
+
+def _jit_helpers(numba: Any, kernel: Callable[..., Any]) -> None:
+    """Compile the helpers a kernel calls (its module's ``HELPERS``) in place, once."""
+    module = sys.modules[kernel.__module__]
+    for helper in getattr(module, 'HELPERS', ()):
+        function = getattr(module, helper)
+        if not hasattr(function, 'py_func'):
+            setattr(module, helper, numba.njit(cache=True, nogil=True)(function))
 
 
 def _moving_load(positions: np.ndarray, forces: np.ndarray, h: float, n_el: int,
@@ -108,4 +122,8 @@ def _finish(u: np.ndarray, a0: float, a1: float, h_v: np.ndarray,
 
 
 _KERNELS: dict[str, Callable[..., Any]] = {
-    'moving_load': _moving_load, 'history': _history, 'finish': _finish}
+    'moving_load': _moving_load, 'history': _history, 'finish': _finish,
+    'rail_rows': contact_kernels.rail_rows, 'rail_values': contact_kernels.rail_values,
+    'rail_load': contact_kernels.rail_load, 'contact_newton': contact_kernels.contact_newton,
+    'rail_predictor': contact_kernels.rail_predictor,
+    'rail_irregularity': contact_kernels.rail_irregularity}

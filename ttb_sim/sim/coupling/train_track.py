@@ -44,6 +44,15 @@ the rail displacement under every wheel is compared with the local prediction;
 any mismatch above ``contact.tolerance`` is fed back and the iteration
 repeated, so each step's contact forces satisfy the contact laws on the exact
 track response to that tolerance.
+
+The lean solver variants take the same step compiled when numba is installed
+(:mod:`ttb_sim.sim.contact_kernels`) and solve the track once per step instead
+of twice: the predictor's rail motion under the wheels comes from each rail
+node's K^-1 columns on the DOFs near it (probed once, with the compliance
+blocks), the contact is iterated on it and the track solved for predictor and
+contact loads together; the exact rail motion then corrects the offsets as
+above, and the step is accepted when all three components agree to the
+tolerance. ``reference`` keeps the numpy step with two solves.
 """
 
 from __future__ import annotations
@@ -51,13 +60,16 @@ from __future__ import annotations
 from dataclasses import dataclass
 import logging
 import math
+from typing import Any, Callable
 
 import numpy as np
+import scipy.sparse as sp
 
 from ttb_sim.errors import DivergenceError, ModelError
 from ttb_sim.fe.factorization import factorize
 from ttb_sim.model.bridge import Structure
 from ttb_sim.model.irregularity import TrackIrregularity
+from ttb_sim.model.irregularity._checks import GRID_SLACK
 from ttb_sim.model.track import BeamLine
 from ttb_sim.model.vehicle.car import CarParameters
 from ttb_sim.model.vehicle.dofs import dofs as car_dofs
@@ -65,6 +77,7 @@ from ttb_sim.model.vehicle.matrices import gyroscopic_matrix, train_matrices
 import ttb_sim.model.wheel_rail as ct
 from ttb_sim.model.wheel_rail.parameters import ContactParameters
 from ttb_sim.model.wheel_rail.profiles import contact_geometry_table, ContactGeometryTable
+from ttb_sim.sim import kernels
 from ttb_sim.sim.coupling.base import VehicleOutputs
 from ttb_sim.sim.integrators.protocol import Integrator
 from ttb_sim.sim.lean import point_rows_and_slopes
@@ -77,6 +90,19 @@ COMPONENTS = 4
 """Contact force components per wheel: Fx, Fy, Fz (on the wheel), Mz (spin moment)."""
 GEOMETRY_STEP = 1e-6
 """Lateral step (m) of the central difference of the rigid-contact wheel height."""
+INFLUENCE_HOPS = 10
+"""Couplings of the effective track matrix over which the single-solve step keeps each
+rail node's K^-1 columns (measured on paper_ttbi: the columns fall to 3e-7 of their peak
+8 couplings away, 3e-15 at 10)."""
+INFLUENCE_PROBE_DISTANCE = 30.0
+"""Least distance (m) between simultaneous probes when the K^-1 columns are kept: the
+probes' responses reach each other through the slab and the girders. Measured error of
+the predictor's rail motion under the wheels: paper_ttbi (0.31 m rail elements) 2e-7 m
+with probes 15 m apart, 4e-12 m at 30 m; a one-span model (0.6 m) 8e-8 m at 15 m,
+9e-13 m at 29 m."""
+INFLUENCE_DROP = 1e-12
+"""Entries of a node's K^-1 columns below this fraction of their largest are dropped
+(on a one-span model 590 of 1 870 DOFs kept per node on average)."""
 
 
 def gather(vector: np.ndarray, index: np.ndarray) -> np.ndarray:
@@ -101,6 +127,30 @@ class ContactState:
     """Newton iterations of the step (all cars)."""
 
 
+@dataclass(frozen=True)
+class ContactKernels:
+    """The compiled kernels of the contact step (:mod:`ttb_sim.sim.contact_kernels`)."""
+
+    rail_rows: Callable[..., Any]
+    rail_values: Callable[..., Any]
+    rail_load: Callable[..., Any]
+    contact_newton: Callable[..., Any]
+    rail_predictor: Callable[..., Any]
+    rail_irregularity: Callable[..., Any]
+
+    @classmethod
+    def load(cls) -> ContactKernels | None:
+        """Return the compiled kernels, or None without numba (the numpy step runs)."""
+        found = []
+        for name in ('rail_rows', 'rail_values', 'rail_load', 'contact_newton',
+                     'rail_predictor', 'rail_irregularity'):
+            kernel = kernels.compiled(name)
+            if kernel is None:
+                return None
+            found.append(kernel)
+        return cls(*found)
+
+
 class RailCompliance:
     """
     Local blocks of the inverse effective track matrix over each rail element.
@@ -113,25 +163,45 @@ class RailCompliance:
         Left and right rail (full DOFs).
     full_to_free : numpy.ndarray
         Extended free index of each full DOF.
+    influence_hops : int, optional
+        Also keep each rail node's K^-1 columns (its 6 DOFs) on the DOFs within
+        this many couplings of the node in the effective matrix, where they
+        exceed INFLUENCE_DROP of their largest (from the same probes, spaced
+        INFLUENCE_PROBE_DISTANCE apart so that they do not disturb each other):
+        :attr:`influence`. None (the reference) keeps only the blocks.
 
     """
 
     def __init__(self, integrator: Integrator, rails: tuple[BeamLine, ...],
-                 full_to_free: np.ndarray) -> None:
+                 full_to_free: np.ndarray, influence_hops: int | None = None) -> None:
         n_free = integrator.mass.shape[0]
         self.blocks = []
+        self.influence: list[tuple[np.ndarray, np.ndarray, np.ndarray]] = []
+        """Per rail: (start (n_nodes + 1,), DOFs (nnz,), values (nnz, 6)): node i's
+        K^-1 columns on the DOFs ``dofs[start[i]:start[i + 1]]``."""
         for rail in rails:
+            spacing = PROBE_SPACING
+            if influence_hops is not None:
+                spacing = max(spacing, math.ceil(INFLUENCE_PROBE_DISTANCE / rail.length.min()))
             dofs = full_to_free[rail.dofs]                     # (n_el, 12)
             nodes = np.vstack([dofs[:, :6], dofs[-1:, 6:]])    # (n_nodes, 6)
             n_nodes = nodes.shape[0]
+            columns = _Columns(n_nodes)
+            reach = sp.csc_matrix((n_free, n_nodes))
+            if influence_hops is not None:
+                reach = neighbourhoods(integrator, nodes, influence_hops)
             # cols[i, j, :] = K^-1 column of node i, DOF j, restricted to nodes i-1..i+1.
             local = np.zeros((n_nodes, 6, 3, 6))
-            for offset in range(PROBE_SPACING):
-                probe = np.arange(offset, n_nodes, PROBE_SPACING)
+            for offset in range(spacing):
+                probe = np.arange(offset, n_nodes, spacing)
                 rhs = np.zeros((n_free + 1, 6))
                 for j in range(6):
                     rhs[nodes[probe, j], j] = 1.0
                 sol = np.vstack([integrator.solve(rhs[:n_free]), np.zeros((1, 6))])
+                if influence_hops is not None:
+                    for p in probe.tolist():
+                        near = reach.indices[reach.indptr[p]:reach.indptr[p + 1]]
+                        columns.add(p, near, sol)
                 for k, shift in enumerate((-1, 0, 1)):
                     at = np.clip(probe + shift, 0, n_nodes - 1)
                     local[probe, :, k, :] = sol[nodes[at]].transpose(0, 2, 1)
@@ -144,6 +214,53 @@ class RailCompliance:
             b[:, :6, 6:] = local[e + 1, :, 0, :].transpose(0, 2, 1)
             b[:, 6:, 6:] = local[e + 1, :, 1, :].transpose(0, 2, 1)
             self.blocks.append(0.5 * (b + b.transpose(0, 2, 1)))
+            if influence_hops is not None:
+                self.influence.append(columns.arrays())
+
+
+class _Columns:
+    """Each rail node's K^-1 columns on its neighbourhood, the small entries dropped."""
+
+    def __init__(self, n_nodes: int) -> None:
+        self._dofs: list[np.ndarray] = [np.zeros(0, dtype=np.intp)] * n_nodes
+        self._values: list[np.ndarray] = [np.zeros((0, 6))] * n_nodes
+
+    def add(self, node: int, near: np.ndarray, solution: np.ndarray) -> None:
+        """Keep the probe solution (n_free + 1, 6) of ``node`` on its DOFs ``near``."""
+        values = solution[near]
+        keep = np.any(np.abs(values) >= INFLUENCE_DROP * np.abs(values).max(), axis=1)
+        self._dofs[node] = near[keep].astype(np.intp)
+        self._values[node] = values[keep]
+
+    def arrays(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Return (start (n_nodes + 1,), DOFs (nnz,), values (nnz, 6)), node after node."""
+        counts = [d.size for d in self._dofs]
+        start = np.concatenate([[0], np.cumsum(counts)]).astype(np.intp)
+        return (start, np.concatenate(self._dofs),
+                np.ascontiguousarray(np.concatenate(self._values)))
+
+
+def neighbourhoods(integrator: Integrator, nodes: np.ndarray, hops: int) -> sp.csc_matrix:
+    """
+    Return the free DOFs within ``hops`` couplings of each node: column i holds node i's.
+
+    Couplings are the non-zeros of the effective matrix (K, C, M).
+    """
+    n_free = integrator.mass.shape[0]
+    pattern = (abs(integrator.stiffness) + abs(integrator.damping)
+               + abs(integrator.mass)).tocsr()
+    pattern.data[:] = 1.0
+    n_nodes = nodes.shape[0]
+    valid = nodes < n_free
+    cols = np.repeat(np.arange(n_nodes), 6)[valid.ravel()]
+    reach = sp.csr_matrix((np.ones(cols.size), (nodes.ravel()[valid.ravel()], cols)),
+                          shape=(n_free, n_nodes))
+    for _ in range(hops):
+        reach = pattern @ reach + reach
+        reach.data[:] = 1.0
+    reach = reach.tocsc()
+    reach.sort_indices()
+    return reach
 
 
 class TrainTrackCoupling:
@@ -210,6 +327,10 @@ class TrainTrackCoupling:
         self.head_arm = np.array([0.0, 0.0, track.rail_head])
         ftf = structure.full_to_free
         self.rail_dofs = tuple(ftf[r.dofs] for r in self.rails)
+        self._kernels = ContactKernels.load() if getattr(integrator, 'lean', False) else None
+        """The compiled contact step (lean variants with numba), else None (numpy step)."""
+        self.influence_hops = INFLUENCE_HOPS if self._kernels is not None else None
+        """Reach of the local K^-1 columns of the single-solve step; None: two solves."""
         self.compliance = self._rail_compliance(integrator, ftf)
         self._no_load = np.zeros(structure.n_full)   # read-only, shared by every frame
         self._speed = math.nan
@@ -232,11 +353,16 @@ class TrainTrackCoupling:
         self._rail_y = np.zeros((n, 8))
         self._rail_offset = np.zeros((n, 8, COMPONENTS))
         self._wheelset_y = 6 * np.repeat(np.arange(3, 7), 2) + 1
+        self._slope_offset = np.zeros((n, 8, 3))
+        self.solves = 0
+        """Track solves of the last step."""
+        self._zero = np.zeros(n_free)
+        self._work: dict[str, np.ndarray] = {}
 
     def _rail_compliance(self, integrator: Integrator,
                          full_to_free: np.ndarray) -> RailCompliance:
         """Return the local rail compliance blocks of the solved system."""
-        return RailCompliance(integrator, self.rails, full_to_free)
+        return RailCompliance(integrator, self.rails, full_to_free, self.influence_hops)
 
     # -- geometry and kinematics ---------------------------------------------------------
     def _rail_rows(self, x: np.ndarray
@@ -395,6 +521,7 @@ class TrainTrackCoupling:
         self.a[:] = 0.0
         self.force[:] = 0.0
         self._rail_offset[:] = 0.0
+        self._slope_offset[:] = 0.0
         self.force[..., 2] = load.reshape(n, 8)
         w = np.einsum('ks,cs->ck', hz, q)
         self.compression = (-(flex @ load) + irr_z.ravel() - w.ravel()).reshape(n, 8)
@@ -420,6 +547,13 @@ class TrainTrackCoupling:
     # -- one step -------------------------------------------------------------------------
     def step(self, head: float, speed: float) -> None:
         """Advance train, track and bridge together to the head position ``head``."""
+        if self._kernels is not None:
+            self._step_compiled(head, speed, self._kernels)
+        else:
+            self._step_numpy(head, speed)
+
+    def _step_numpy(self, head: float, speed: float) -> None:
+        """Take the step with numpy (the reference path, and the lean path without numba)."""
         self._update_speed(speed)
         nm, n = self.nm, self.n_cars
         n_free = self.n_free
@@ -577,6 +711,171 @@ class TrainTrackCoupling:
         self._rail_y = r_exact[..., 1]
         self.saturation = eps
         self.iterations = total_iter
+        self.solves = _outer + 2
+
+    def _buffer(self, name: str, shape: tuple[int, ...], dtype: Any = float) -> np.ndarray:
+        """Return a work array of the compiled step, reallocated when its shape changes."""
+        buf = self._work.get(name)
+        if buf is None or buf.shape != shape:
+            buf = self._work[name] = np.zeros(shape, dtype=dtype)
+        return buf
+
+    def _geometry_tables(self) -> tuple[np.ndarray, ...]:
+        """Return the profile table's columns for the compiled step (empty: the cone)."""
+        table = self.table
+        if table is None:
+            return np.zeros(0), np.zeros((0, 2)), np.zeros((0, 2)), np.zeros(0), np.zeros(0)
+        return tuple(np.ascontiguousarray(c, dtype=float) for c in (
+            table.lateral, table.rolling_radius, table.contact_angle, table.rise, table.roll))
+
+    def _step_compiled(self, head: float, speed: float, k: ContactKernels) -> None:
+        """
+        Take the step with the compiled kernels: the numpy step's formulas, in loops.
+
+        The rail rows, the local compliance, the Newton iteration of the contact
+        laws and the rail loads and responses run compiled
+        (:mod:`ttb_sim.sim.contact_kernels`); the train's small dense products and
+        the irregularity stay as in :meth:`_step_numpy`.
+
+        With the local K^-1 columns (:attr:`influence_hops`) the step solves the
+        track once: the rail motion of the predictor under the wheels comes from
+        those columns, its small error joins the rail offset (and a slope offset),
+        and the one solve is of the whole right-hand side, predictor and contact
+        loads together. The step is accepted, as in the numpy step, when the
+        exact rail displacement under every wheel agrees with the local model to
+        ``contact.tolerance``; otherwise the offsets are corrected and the track
+        solved again. Without the columns the track is solved twice, as in the
+        numpy step.
+        """
+        self._update_speed(speed)
+        nm, n = self.nm, self.n_cars
+        n_free = self.n_free
+        m = 8 * COMPONENTS
+        x = head + self.contact_x
+        rows = self._buffer('rows', (n, 8, 3, 12))
+        slope = self._buffer('slope', (n, 8, 3, 12))
+        dofs = self._buffer('dofs', (n, 8, 12), np.intp)
+        element = self._buffer('element', (n, 8), np.intp)
+        dr = self._buffer('dr', (n, 8, 3, 3))
+        ds = self._buffer('ds', (n, 8, 3, 3))
+        left, right = self.rails
+        off = k.rail_rows(x, self.side, left.start, left.length, self.rail_dofs[0],
+                          self.compliance.blocks[0], right.start, right.length,
+                          self.rail_dofs[1], self.compliance.blocks[1],
+                          float(self.head_arm[2]), rows, slope, dofs, dr, ds, element)
+        if off >= 0:
+            raise DivergenceError('a wheel ran off the modelled track at x = '
+                                  f'{x.flat[off]:.2f} m; the run is longer than '
+                                  'the track (check solver.duration)')
+        irr_z, irr_y, irr_dy = np.zeros((n, 8)), np.zeros((n, 8)), np.zeros((n, 8))
+        irr = self.irregularity
+        if irr is not None:
+            k.rail_irregularity(x, self.side, float(irr.x_start), float(irr.dx), irr.values,
+                                irr.slopes, irr.curvatures, GRID_SLACK, irr_z, irr_y, irr_dy)
+
+        # Predictors (no contact force).
+        single = bool(self.compliance.influence)
+        zero = self._zero if self._zero.shape[0] == n_free else np.zeros(n_free)
+        h_v, h_a = nm.history(self.u, self.v, self.a)
+        rhs = nm.effective_load(zero, h_v, h_a)
+        r_star = np.empty((n, 8, 3))
+        rs_star = np.empty((n, 8, 3))
+        r_hist = np.empty((n, 8, 3))
+        if single:
+            infl_l, infl_r = self.compliance.influence
+            k.rail_predictor(element, self.side, *infl_l, *infl_r, rows, slope, rhs, r_star,
+                             rs_star)
+            u_star = rhs
+        else:
+            u_star = nm.solve(rhs)
+            k.rail_values(rows, u_star, dofs, r_star)
+            k.rail_values(slope, u_star, dofs, rs_star)
+        k.rail_values(rows, h_v, dofs, r_hist)
+        a0, a1 = nm.a0, nm.a1
+        qh_v = -a1 * self.q - self.qv
+        qh_a = -a0 * self.q - 2.0 * a1 * self.qv - self.qa
+        rhs_t = self.gravity - qh_a @ self.mass.T - qh_v @ self.train_damping.T
+        q_star = rhs_t @ self.a_inv.T
+        w0 = q_star @ self.h.T
+        wv0 = a1 * w0 + qh_v @ self.h.T
+        normal = np.maximum(self.force[..., 2], 0.0)
+        f11, f22, f23, f33 = (np.ascontiguousarray(np.broadcast_to(f, (n, 8))) for f in
+                              ct.scale_creep_coefficients(self.creep0, self.p0, normal))
+        r0p = np.zeros((n, 8, COMPONENTS))
+        r0p[..., :3] = r_star
+        rv0 = np.zeros((n, 8, COMPONENTS))
+        rv0[..., :3] = a1 * r_star + r_hist + speed * rs_star
+        rvel = a1 * dr + speed * ds
+        offset = self._rail_offset.copy()
+        slope_offset = self._slope_offset.copy()
+        y_star = np.ascontiguousarray(q_star[:, self._wheelset_y])
+        ey = np.ascontiguousarray(self.ey)
+        lateral, radius_table, angle_table, rise, roll = self._geometry_tables()
+        g = self.force.reshape(n, m).copy()
+        y_rel = np.empty((n, 8))
+        delta = np.empty((n, 8))
+        eps = np.empty((n, 8))
+        load = self._buffer('load', (n_free + 1,))
+        r_exact = np.empty((n, 8, 3))
+        rs_exact = np.empty((n, 8, 3))
+        slope_mismatch = np.zeros((n, 8, 3))
+        total_iter = 0
+        for _outer in range(self.max_iter):
+            rp = (r0p + offset).reshape(n, m)
+            rvp = rv0 + a1 * offset
+            if single:
+                rvp[..., :3] += speed * slope_offset
+            rvp = rvp.reshape(n, m)
+            iterations, change = k.contact_newton(
+                g, w0, wv0, rp, rvp, self.dw, dr, rvel, ey, y_star, irr_y, irr_z, irr_dy,
+                self.side, f11, f22, f23, f33, lateral, radius_table, angle_table, rise, roll,
+                float(self.params.contact_semi_distance), float(self.contact.conicity),
+                float(self.r0), self.g_hertz, float(self.friction), a1, float(speed),
+                GEOMETRY_STEP, float(self.tol), int(self.max_iter), y_rel, delta, eps)
+            total_iter += iterations
+            if not change < self.tol:
+                raise DivergenceError(f'contact iteration did not converge in {self.max_iter} '
+                                      f'iterations (last change {change:.3g} m)')
+            # Exact track response to these forces.
+            k.rail_load(rows, g, dofs, load)
+            if single:
+                u_new = nm.solve(rhs + load[:n_free])
+            else:
+                u_new = u_star + nm.solve(load[:n_free])
+            k.rail_values(rows, u_new, dofs, r_exact)
+            gx = g.reshape(n, 8, COMPONENTS)[..., :3]
+            r_model = rp.reshape(n, 8, COMPONENTS)[..., :3] - np.einsum('cwij,cwj->cwi', dr, gx)
+            mismatch = r_exact - r_model
+            if single:
+                k.rail_values(slope, u_new, dofs, rs_exact)
+                slope_mismatch = rs_exact - (rs_star + slope_offset
+                                             - np.einsum('cwij,cwj->cwi', ds, gx))
+            # The single-solve step checks every component: its predictor is local too.
+            if np.max(np.abs(mismatch if single else mismatch[..., 2])) <= self.tol:
+                break
+            offset[..., :3] += mismatch
+            slope_offset += slope_mismatch
+        else:
+            raise DivergenceError('rail displacement under the wheels did not converge to '
+                                  f'contact.tolerance = {self.tol:g} m')
+
+        self._check_flange(y_rel)
+        self._rail_offset = offset
+        self._rail_offset[..., :3] += mismatch
+        self._slope_offset = slope_offset + slope_mismatch
+        # Accept the step.
+        q_new = q_star + (g @ self.h) @ self.a_inv.T
+        self.qv = a1 * q_new + qh_v
+        self.qa = a0 * q_new + qh_a
+        self.q = q_new
+        self.v, self.a = nm.finish(u_new, h_v, h_a)
+        self.u = u_new
+        self.force = g.reshape(n, 8, COMPONENTS)
+        self.compression = delta
+        self._rail_y = r_exact[..., 1].copy()
+        self.saturation = eps
+        self.iterations = total_iter
+        self.solves = _outer + 1 + (0 if single else 1)
 
     # -- the Coupling protocol ------------------------------------------------------------
     def start(self, head: float) -> None:
