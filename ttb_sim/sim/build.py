@@ -80,8 +80,9 @@ def build_foundation(scenario: Scenario) -> FoundationOperator:
     b, pr = scenario.bridge, scenario.piers
     f1 = span_frequency(b.span_length, b.bending_stiffness, b.mass_per_length)
     return pile_soil_operator(scenario.substructure(), pr.height, pr.elements,
-                              pier_section(pr), rayleigh_coefficients(b.damping_ratio, f1,
-                                                                      4 * f1))
+                              pier_section(pr),
+                              rayleigh_coefficients(b.damping_ratio, f1, 4 * f1),
+                              scenario.soil.reduction)
 
 
 def build_vehicle(scenario: Scenario) -> Vehicle:
