@@ -38,3 +38,16 @@ def quad_variance() -> Callable[..., float]:
     the reference its variance is checked against (V8, V10).
     """
     return _quad_variance
+
+
+@pytest.fixture(autouse=True, scope='session')
+def _substructure_cache(tmp_path_factory):
+    """Keep the reduced substructures the tests build in one session-wide cache, not ~/.cache."""
+    import os
+    previous = os.environ.get('TTB_SIM_CACHE')
+    os.environ['TTB_SIM_CACHE'] = str(tmp_path_factory.mktemp('ttb_sim_cache'))
+    yield
+    if previous is None:
+        os.environ.pop('TTB_SIM_CACHE', None)
+    else:
+        os.environ['TTB_SIM_CACHE'] = previous
