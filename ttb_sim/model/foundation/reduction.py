@@ -332,7 +332,9 @@ def reduction_basis(tied: TiedSubstructure, reduction: ReductionParameters
             blocks += [part for q in found for part in (q.real, q.imag)]
         LOG.debug('reduction: %d Krylov blocks after the shift at %g Hz', len(blocks), f)
     w_all = np.hstack(blocks)
+    del blocks
     interior = w_all[6:] - psi[6:] @ w_all[:6]
+    del w_all
     return psi, _orthonormal(interior, weight[6:], reduction.tolerance)
 
 
@@ -398,17 +400,18 @@ def _block(r: np.ndarray, s: np.ndarray, qs: list[np.ndarray], ps: list[np.ndarr
 
 
 def _orthonormal(w: np.ndarray, weight: np.ndarray, tol: float) -> np.ndarray:
-    """Return a weight-orthonormal basis of the columns of w, dropping dependent ones."""
+    """
+    Return a weight-orthonormal basis of the columns of w, dropping dependent ones.
+
+    The columns come from vectors of unit weighted norm (their master part
+    removed), so a direction is kept when what is left of it outside the
+    others is above ``tol``.
+    """
     root = np.sqrt(weight)
-    a = root[:, None] * w
-    norms = np.linalg.norm(a, axis=0)
-    a = a[:, norms > 0] / norms[norms > 0]
-    if a.shape[1] == 0:
+    if w.shape[1] == 0:
         return np.zeros((len(weight), 0))
-    qq, rr, _ = sla.qr(a, mode='economic', pivoting=True)
-    d = np.abs(np.diag(rr))
-    keep = int(np.count_nonzero(d > max(tol, 1e-12)))
-    # two passes of Gram-Schmidt would give the same span; QR keeps it orthonormal to round-off
+    qq, rr, _ = sla.qr(root[:, None] * w, mode='economic', pivoting=True)
+    keep = int(np.count_nonzero(np.abs(np.diag(rr)) > tol))
     return qq[:, :keep] / root[:, None]
 
 
