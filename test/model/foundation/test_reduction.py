@@ -148,8 +148,8 @@ def test_pier_top_dynamic_flexibility_converges_with_the_basis(full, large):
 
     Error: Frobenius norm of the difference over that of H, both scaled by the
     static diagonal (so translations and rotations weigh alike; 0 Hz is the
-    static test above). Measured with levels 4 (118 coordinates) / 8 (182): 1.4e-4 /
-    9e-9 at 2 Hz, 3.9e-2 / 2.6e-3 at 5 Hz, 0.20 / 0.060 at 10 Hz, 0.15 / 0.024 at
+    static test above). Measured with levels 4 (114 coordinates) / 8 (178): 1.0e-4 /
+    7e-9 at 2 Hz, 3.9e-2 / 2.6e-3 at 5 Hz, 0.19 / 0.056 at 10 Hz, 0.15 / 0.028 at
     30 Hz (this mesh resolves 1.4 Hz in its coarsest cells: a dense set of mesh
     resonances the real shifts approach slowly).
     """

@@ -32,7 +32,11 @@ The reduced-order pier-cap-pile-soil substructure of one piled pier.
    positive definite, is factorised once (CHOLMOD), and the sequence
    r_1 = Z^-1 B, r_j = -Z^-1 ((C + 2 s M) r_{j-1} + M r_{j-2}) (the moments
    of (K + sigma C + sigma^2 M)^-1 B about sigma = s, the SOAR recurrence of
-   Bai & Su 2005, orthogonalised as it goes) spans the response. The vectors
+   Bai & Su 2005, orthogonalised as it goes) spans the response. (With
+   ``shift_axis='imaginary'`` the shift is s = i w: Z = K - w^2 M + i w C,
+   complex symmetric, solved through the LDL^T factors of its real 2n form,
+   and the real and imaginary parts of the vectors enter the basis; exact at
+   w, but far dearer to factorise.) The vectors
    of all shifts, less their master part (so that V vanishes on the master),
    are mass-orthonormalised with deflation. The damping is projected, not
    diagonalised (the boundary dashpots make it far from proportional). The
