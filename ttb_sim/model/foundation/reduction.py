@@ -319,20 +319,25 @@ def reduction_basis(tied: TiedSubstructure, reduction: ReductionParameters
     psi = np.empty((n, 6))
     psi[:6] = np.eye(6)
     psi[6:] = np.linalg.solve(x0[:6].T, x0[6:].T).T
+    del x0
     blocks: list[np.ndarray] = []
+    if 0.0 in reduction.shifts:
+        blocks += _soar(static.solve, c, m, weight, b, reduction.levels, reduction.tolerance)
+    del static  # one factorisation in memory at a time
     for f in reduction.shifts:
         w = 2 * math.pi * float(f)
         if w == 0:
-            blocks += _soar(static.solve, c, m, weight, b, reduction.levels,
-                            reduction.tolerance)
-        elif reduction.shift_axis == 'real':
+            continue
+        if reduction.shift_axis == 'real':
             solver = factorize(_symmetric(k + w * c + (w * w) * m), method=FACTORIZATION)
             blocks += _soar(solver.solve, (c + 2 * w * m).tocsr(), m, weight, b,
                             reduction.levels, reduction.tolerance)
+            del solver
         else:
             solve = _complex_solver(k, c, m, w)
             found = _soar(solve, (c + 2j * w * m).tocsr(), m, weight, b.astype(complex),
                           reduction.levels, reduction.tolerance)
+            del solve
             blocks += [part for q in found for part in (q.real, q.imag)]
         LOG.debug('reduction: %d Krylov blocks after the shift at %g Hz', len(blocks), f)
     w_all = np.hstack(blocks)
