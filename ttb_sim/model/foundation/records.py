@@ -154,15 +154,15 @@ class ReductionParameters:
     Reduced-order model of a piled pier for the coupled run (``soil.reduction``).
 
     The soil-pile-cap interior is replaced by the static modes of the cap-top
-    master plus second-order block Krylov vectors of the master loads at real
-    shifts s = 2 pi f (see :mod:`.reduction`): up to 6 vectors per level and
-    shift.
+    master plus second-order block Krylov vectors of the master loads at shifts
+    s = 2 pi f (or i 2 pi f) (see :mod:`.reduction`): up to 6 vectors per level
+    and real shift, 12 per imaginary one.
     """
 
     shifts: tuple[float, ...] = param(
-        (0.0, 15.0), 'Hz', 'Real expansion points f of the Krylov vectors (shift s = 2 pi f '
-        'of the pencil K + s C + s^2 M); 0 = about the static solution.', low=0.0,
-        high=1000.0)
+        (0.0, 5.0, 10.0, 20.0, 30.0), 'Hz', 'Expansion points f of the Krylov vectors '
+        '(shift s = 2 pi f, or i 2 pi f, see soil.reduction.shift_axis); 0 = about the '
+        'static solution.', low=0.0, high=1000.0)
     shift_axis: str = param('real', '-', "Where the shifts lie: 'imaginary' = s = i 2 pi "
                             'f, the complex pencil K - w^2 M + i w C factorised by LDL^T of its '
                             "real 2n form; 'real' = s = 2 pi f, the positive definite K + s C + "

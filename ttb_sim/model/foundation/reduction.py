@@ -32,7 +32,11 @@ The reduced-order pier-cap-pile-soil substructure of one piled pier.
    positive definite, is factorised once (CHOLMOD), and the sequence
    r_1 = Z^-1 B, r_j = -Z^-1 ((C + 2 s M) r_{j-1} + M r_{j-2}) (the moments
    of (K + sigma C + sigma^2 M)^-1 B about sigma = s, the SOAR recurrence of
-   Bai & Su 2005, orthogonalised as it goes) spans the response. The vectors
+   Bai & Su 2005, orthogonalised as it goes) spans the response. (With
+   ``shift_axis='imaginary'`` the shift is s = i w: Z = K - w^2 M + i w C,
+   complex symmetric, solved through the LDL^T factors of its real 2n form,
+   and the real and imaginary parts of the vectors enter the basis; exact at
+   w, but far dearer to factorise.) The vectors
    of all shifts, less their master part (so that V vanishes on the master),
    are mass-orthonormalised with deflation. The damping is projected, not
    diagonalised (the boundary dashpots make it far from proportional). The
@@ -315,24 +319,31 @@ def reduction_basis(tied: TiedSubstructure, reduction: ReductionParameters
     psi = np.empty((n, 6))
     psi[:6] = np.eye(6)
     psi[6:] = np.linalg.solve(x0[:6].T, x0[6:].T).T
+    del x0
     blocks: list[np.ndarray] = []
+    if 0.0 in reduction.shifts:
+        blocks += _soar(static.solve, c, m, weight, b, reduction.levels, reduction.tolerance)
+    del static  # one factorisation in memory at a time
     for f in reduction.shifts:
         w = 2 * math.pi * float(f)
         if w == 0:
-            blocks += _soar(static.solve, c, m, weight, b, reduction.levels,
-                            reduction.tolerance)
-        elif reduction.shift_axis == 'real':
+            continue
+        if reduction.shift_axis == 'real':
             solver = factorize(_symmetric(k + w * c + (w * w) * m), method=FACTORIZATION)
             blocks += _soar(solver.solve, (c + 2 * w * m).tocsr(), m, weight, b,
                             reduction.levels, reduction.tolerance)
+            del solver
         else:
             solve = _complex_solver(k, c, m, w)
             found = _soar(solve, (c + 2j * w * m).tocsr(), m, weight, b.astype(complex),
                           reduction.levels, reduction.tolerance)
+            del solve
             blocks += [part for q in found for part in (q.real, q.imag)]
         LOG.debug('reduction: %d Krylov blocks after the shift at %g Hz', len(blocks), f)
     w_all = np.hstack(blocks)
+    del blocks
     interior = w_all[6:] - psi[6:] @ w_all[:6]
+    del w_all
     return psi, _orthonormal(interior, weight[6:], reduction.tolerance)
 
 
@@ -398,17 +409,18 @@ def _block(r: np.ndarray, s: np.ndarray, qs: list[np.ndarray], ps: list[np.ndarr
 
 
 def _orthonormal(w: np.ndarray, weight: np.ndarray, tol: float) -> np.ndarray:
-    """Return a weight-orthonormal basis of the columns of w, dropping dependent ones."""
+    """
+    Return a weight-orthonormal basis of the columns of w, dropping dependent ones.
+
+    The columns come from vectors of unit weighted norm (their master part
+    removed), so a direction is kept when what is left of it outside the
+    others is above ``tol``.
+    """
     root = np.sqrt(weight)
-    a = root[:, None] * w
-    norms = np.linalg.norm(a, axis=0)
-    a = a[:, norms > 0] / norms[norms > 0]
-    if a.shape[1] == 0:
+    if w.shape[1] == 0:
         return np.zeros((len(weight), 0))
-    qq, rr, _ = sla.qr(a, mode='economic', pivoting=True)
-    d = np.abs(np.diag(rr))
-    keep = int(np.count_nonzero(d > max(tol, 1e-12)))
-    # two passes of Gram-Schmidt would give the same span; QR keeps it orthonormal to round-off
+    qq, rr, _ = sla.qr(root[:, None] * w, mode='economic', pivoting=True)
+    keep = int(np.count_nonzero(np.abs(np.diag(rr)) > tol))
     return qq[:, :keep] / root[:, None]
 
 
