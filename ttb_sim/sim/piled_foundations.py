@@ -228,6 +228,18 @@ class PiledFoundations:
         return u, v
 
 
+def pile_coordinates(structure: Structure, foundations: PiledFoundations,
+                     ue: np.ndarray) -> list[np.ndarray]:
+    """Return the coordinates q of every piled pier with an interface, in structure order."""
+    states = iter(foundations.current())
+    out = []
+    for pier in structure.piled:
+        q = ue[pier.block] if pier.block is not None else next(states).u
+        if pier.operator.interface is not None:
+            out.append(q)
+    return out
+
+
 def pile_outputs(structure: Structure, foundations: PiledFoundations, ue: np.ndarray,
                  ve: np.ndarray, ae: np.ndarray) -> dict[str, np.ndarray]:
     """
@@ -307,3 +319,48 @@ class RigidDisplacement:
                  'computed_peak': float(self._peak[1, i]), 'rigid_rms': float(rms[0, i]),
                  'computed_rms': float(rms[1, i]), 'difference_rms': float(rms[2, i])}
                 for i, k in enumerate(self.spans)]
+
+
+class InterfaceCheck:
+    """
+    How far the piles' interface is from slipping: the check that the linear reduction holds.
+
+    The reduced substructure keeps the Desai interface at its initial tangent.
+    This keeps every ``stride``-th frame's coordinates of each piled pier and
+    reports, at the end, the largest |tau| / tau_f over the interface and the
+    run (:func:`~ttb_sim.model.foundation.reduction.interface_mobilisation`):
+    for the train's increment alone, and with ``dead_load`` (N: two half-spans
+    and the pier column) on the pier top added as a static state.
+    """
+
+    def __init__(self, structure: Structure, dead_load: float, stride: int = 10) -> None:
+        self.piers = [p for p in structure.piled if p.operator.interface is not None]
+        self.stride = stride
+        self._frames = 0
+        self._history: list[list[np.ndarray]] = [[] for _ in self.piers]
+        self._dead = []
+        for pier in self.piers:
+            force = np.zeros(pier.operator.size)
+            force[2] = -dead_load        # on the pier top, all of it: the soil sees the sum
+            self._dead.append(np.linalg.solve(pier.operator.stiffness, force))
+
+    def update(self, states: list[np.ndarray]) -> None:
+        """Take one frame: the coordinates of every checked pier, in order."""
+        if self._frames % self.stride == 0:
+            for history, q in zip(self._history, states):
+                history.append(q.copy())
+        self._frames += 1
+
+    def summary(self) -> dict[str, dict[str, float]]:
+        """Return per pier the largest mobilisation, train only and with the dead load."""
+        from ttb_sim.model.foundation.reduction import interface_mobilisation
+
+        out = {}
+        for pier, history, dead in zip(self.piers, self._history, self._dead):
+            if not history:
+                continue
+            q = np.array(history)
+            out[f'pier{pier.support + 1:02d}'] = {
+                'train': interface_mobilisation(pier.operator, q),
+                'with_dead_load': interface_mobilisation(pier.operator, q + dead)}
+        return out

@@ -30,13 +30,15 @@ import numpy as np
 from ttb_sim.config import Scenario
 from ttb_sim.errors import DivergenceError, ModelError, ScenarioError
 from ttb_sim.model.bridge import bearing_forces
+from ttb_sim.model.constants import GRAVITY
 from ttb_sim.model.vehicle.train import MultibodyCars
 from ttb_sim.sim.build import (build_coupling, build_structure, build_vehicle, observer_rows,
                                vehicle_track_setup)
 from ttb_sim.sim.cost import CostEstimate, estimate_cost, STEP_BUDGET
 from ttb_sim.sim.frames import Frame, Layout
 from ttb_sim.sim.integrators.newmark import Newmark
-from ttb_sim.sim.piled_foundations import pile_outputs, PiledFoundations, RigidDisplacement
+from ttb_sim.sim.piled_foundations import (InterfaceCheck, pile_coordinates, pile_outputs,
+                                           PiledFoundations, RigidDisplacement)
 from ttb_sim.sim.variants import blas_threads, solver_variant
 
 log = logging.getLogger(__name__)
@@ -140,6 +142,9 @@ class Simulation:
         self.foundations = PiledFoundations(st, self.integrator,
                                             scenario.solver.substructure_steps)
         self.rigid = RigidDisplacement(st)
+        b, pr = scenario.bridge, scenario.piers
+        self.interface = InterfaceCheck(st, GRAVITY * (b.mass_per_length * b.span_length
+                                                       + pr.mass_per_length * pr.height))
         self.layout = Layout(n_spans=scenario.bridge.n_spans, n_supports=st.n_supports,
                              n_bodies=self.coupling.n_bodies, n_axles=self.coupling.n_axles,
                              observers=names,
@@ -231,6 +236,7 @@ class Simulation:
                                  'coordinates': p.operator.size, **p.operator.summary}
                                  for p in st.piled}}
             about['rigid_displacement'] = self.rigid.summary()
+            about['interface_mobilisation'] = self.interface.summary()
         return about
 
     def auto_duration(self) -> float:
@@ -299,6 +305,7 @@ class Simulation:
         piles = pile_outputs(st, self.foundations, ue, ve, ae)
         if piles:
             self.rigid.update(ue[st.midspan_dofs], piles['pile_displacement'])
+            self.interface.update(pile_coordinates(st, self.foundations, ue))
         return Frame(step=step, time=step * self.dt, head_position=head, speed=self.speed,
                      midspan=ue[st.midspan_dofs],
                      bearings=bearing_forces(st, ue, ve, ae, cp.structure_load(head), tops),
