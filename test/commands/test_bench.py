@@ -35,7 +35,8 @@ def _check_run(run: dict) -> None:
                 'ms_per_step', 'cpu_ms_per_step', 'real_time_factor', 'peak_rss_mib',
                 'difference'):
         assert key in run, key
-    assert set(run['dofs']) == {'structure', 'track', 'bridge', 'vehicle', 'total', 'solved'}
+    assert set(run['dofs']) == {'structure', 'track', 'bridge', 'vehicle', 'substructures',
+                                'substructures_full', 'total', 'solved'}
     assert run['dofs']['solved'] <= run['dofs']['total']
     assert set(run['difference']) == set(bn.QUANTITIES)
     for quantity in run['difference'].values():
