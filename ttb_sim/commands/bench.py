@@ -114,9 +114,11 @@ def _dof_counts(sim: Any) -> dict[str, int]:
     # full FE DOFs they were reduced from
     inside = sum(p.operator.size for p in st.piled if p.block is not None)
     beside = sum(p.operator.size for p in st.piled if p.block is None)
-    full = sum(int(p.operator.summary.get('full_dofs', p.operator.size)) for p in st.piled)
+    reduced_from = sum(int(p.operator.summary.get('full_dofs', p.operator.size))
+                       for p in st.piled)
     return {'structure': st.n_free, 'track': track, 'bridge': st.n_free - track - inside,
-            'vehicle': vehicle, 'substructures': inside + beside, 'substructures_full': full,
+            'vehicle': vehicle, 'substructures': inside + beside,
+            'substructures_full': reduced_from,
             'total': st.n_free + vehicle + beside, 'solved': solved + vehicle + beside}
 
 

@@ -650,10 +650,10 @@ def assemble_structure(b: BridgeParameters, br: BearingParameters, pr: PierParam
                               full_dofs=cdofs, support=c_support, component=c_component)
     bearings = None
     if bearing_links is not None:
-        kin, link_full, kdir, cdir, support, side = bearing_links
+        kin, link_full, kdir, cdir, link_support, side = bearing_links
         ext = np.where(link_full >= 0, full_to_free[np.maximum(link_full, 0)], n_free)
         bearings = Bearings(kinematics=kin, dofs=ext, stiffness=kdir, damping=cdir,
-                            support=support, side=side)
+                            support=link_support, side=side)
 
     el_nodes = girders.elements
     wfull = el_nodes[:, [0, 0, 1, 1]] * NODE_DOFS + W_DOFS % NODE_DOFS
