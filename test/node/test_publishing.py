@@ -98,3 +98,76 @@ def test_stop_ends_an_idle_loop_and_offers_after_it_are_harmless() -> None:
 def test_duty_outside_its_range_is_refused() -> None:
     with pytest.raises(ValueError, match='duty'):
         PublishLoop(lambda frames, markers: None, duty=0.0)
+
+
+class FakeClocks:
+    """A CPU clock that each publish call advances by ``cost``, and a wall clock set by hand."""
+
+    def __init__(self, cost: float) -> None:
+        self.cost = cost
+        self.cpu = 0.0
+        self.wall = 0.0
+        self.batches: list[list[Any]] = []
+
+    def publish(self, frames: Sequence[Any], markers: bool) -> None:
+        self.batches.append(list(frames))
+        self.cpu += self.cost
+
+
+def test_inline_publishing_runs_on_the_caller_in_order() -> None:
+    """Without a thread, each offer publishes its frames at once, as one batch."""
+    caller = threading.get_ident()
+    seen: list[int] = []
+
+    def publish(frames: Sequence[Any], markers: bool) -> None:
+        seen.append(threading.get_ident())
+        batches.append(list(frames))
+
+    batches: list[list[Any]] = []
+    loop = PublishLoop(publish, duty=1.0, threaded=False)
+    loop.start()
+    for k in range(5):
+        loop.offer([2 * k, 2 * k + 1])
+    assert batches == [[0, 1], [2, 3], [4, 5], [6, 7], [8, 9]]
+    assert set(seen) == {caller}
+    assert loop.stats().published == 10 and loop.stats().dropped == 0
+
+
+def test_inline_publishing_rests_within_its_duty_and_counts_drops() -> None:
+    """
+    A batch costing s of CPU makes the loop rest s (1 - duty) / duty of wall time.
+
+    Duty 0.25 and 10 ms per batch: 30 ms of rest. Frames offered meanwhile wait
+    (the newest ``max_backlog``) and go out with the first offer after the rest.
+    """
+    clocks = FakeClocks(cost=0.010)
+    loop = PublishLoop(clocks.publish, duty=0.25, max_backlog=3, threaded=False,
+                       clock=lambda: clocks.cpu, wall=lambda: clocks.wall)
+    loop.offer([0])                       # published at t = 0: rest until 30 ms
+    for k in range(1, 6):                 # t = 5 ... 25 ms: resting, frames wait
+        clocks.wall = 0.005 * k
+        loop.offer([k])
+    assert clocks.batches == [[0]]
+    clocks.wall = 0.030
+    loop.offer([])                        # the rest is over: the waiting frames go out
+    assert clocks.batches == [[0], [3, 4, 5]]
+    stats = loop.stats()
+    assert (stats.offered, stats.published, stats.dropped) == (6, 4, 2)
+    assert stats.busy == pytest.approx(0.020)
+
+
+def test_inline_publishing_errors_stop_publishing_without_raising() -> None:
+    calls: list[int] = []
+
+    def broken(frames: Sequence[Any], markers: bool) -> None:
+        calls.append(len(frames))
+        raise RuntimeError('publisher context is invalid')
+
+    loop = PublishLoop(broken, duty=0.5, threaded=False)
+    loop.offer([1, 2])                    # the stepping thread is never hit by the error
+    loop.offer([3])
+    assert calls == [2]
+    assert 'publisher context is invalid' in loop.error
+    loop.stop()
+    loop.offer([4])
+    assert calls == [2]

@@ -163,10 +163,13 @@ class PassageController:
         self._exit_time: float | None = None
         self._next_publish = 0.0
         self._last_markers = -math.inf
-        self._window = (clock(), 0.0, 0, 0.0)   # wall, sim time, steps, stepping seconds
+        # wall, sim time, steps, stepping seconds (wall), stepping CPU seconds
+        self._window = (clock(), 0.0, 0, 0.0, 0.0)
         self._sim_total = 0.0
         self._steps_total = 0
         self._stepping_total = 0.0
+        self._stepping_cpu = 0.0
+        self._base_every = 1
         self._start_passage()
 
     # -- commands -----------------------------------------------------------------------
@@ -279,6 +282,7 @@ class PassageController:
             if self.state != 'running':
                 tick.sleep = 0.1
                 return tick
+            self._set_frame_stride()
             now = self._clock()
             rtf = float(self.values['real_time_factor'])
             if self._anchor is None:
@@ -287,6 +291,7 @@ class PassageController:
             target = math.inf if rtf == 0 else sim0 + rtf * (now - wall0)
             deadline = time.perf_counter() + budget
             started = time.perf_counter()
+            started_cpu = time.thread_time()
             while (self.state == 'running' and tick.stepped < max_frames
                    and (self.last_frame is None
                         or self._node_time + self.frame_period <= target + 1e-12)):
@@ -294,6 +299,7 @@ class PassageController:
                 if time.perf_counter() > deadline:
                     break
             self._stepping_total += time.perf_counter() - started
+            self._stepping_cpu += time.thread_time() - started_cpu
             if self.state == 'running' and rtf > 0:
                 due = wall0 + (self._node_time + self.frame_period - sim0) / rtf
                 lag = now - due
@@ -332,6 +338,27 @@ class PassageController:
                 self._next_publish = frame.time + period
         if self._passage_over(raw):
             self._end_passage(tick)
+
+    def _set_frame_stride(self) -> None:
+        """
+        Compute frames only at the publishing rate while no recorder needs every frame.
+
+        A frame (bearing forces, outputs) costs about as much as a step; without a
+        bag only the published ones are needed. The stride is the scenario's
+        output interval times the whole number of them in one publishing period
+        (1 when the period is not a whole multiple, or 0 Hz: every frame). It is
+        changed between frames only, so frame times stay exact.
+        """
+        sim = self.sim
+        if not isinstance(sim, Simulation):
+            return
+        stride = 1
+        period = self._publish_period()
+        if self.recorder is None and period > 0:
+            ratio = period / (sim.dt * self._base_every)
+            if abs(ratio - round(ratio)) < 1e-6:
+                stride = max(1, round(ratio))
+        sim.output_every = self._base_every * stride
 
     def _publish_period(self) -> float:
         rate = float(self.values['publish_rate_hz'])
@@ -381,6 +408,7 @@ class PassageController:
         """Build a new simulation from the current parameters and start stepping it."""
         scenario = self.passage_scenario()
         self.sim = make_runner(scenario)
+        self._base_every = self.sim.output_every
         self._frames = self.sim.frames()
         self._exit_time = None
         self.passage += 1
@@ -433,8 +461,10 @@ class PassageController:
         """
         with self._lock:
             now = self._clock()
-            wall0, sim0, steps0, busy0 = self._window
-            self._window = (now, self._sim_total, self._steps_total, self._stepping_total)
+            wall0, sim0, steps0, busy0, cpu0 = self._window
+            self._window = (now, self._sim_total, self._steps_total, self._stepping_total,
+                            self._stepping_cpu)
+            cpu = self._stepping_cpu - cpu0
             wall = now - wall0
             sim_dt = self._sim_total - sim0
             steps = self._steps_total - steps0
@@ -449,6 +479,8 @@ class PassageController:
                 ('real-time factor', f'{rtf:.3g}'),
                 ('real-time factor target (0 = max)', f'{target:g}'),
                 ('step time (ms)', f'{step_ms:.4f}'),
+                ('stepping CPU time per simulated second (s)',
+                 f'{cpu / sim_dt:.3f}' if sim_dt > 0 else '0'),
                 ('solver dt (s)', f'{self.sim.dt:.6g}'),
                 ('contact iterations', '0'),  # the wheel-girder coupling is solved directly
                 ('divergence', self.divergence or 'none'),

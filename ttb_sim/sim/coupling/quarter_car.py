@@ -28,17 +28,24 @@ When the girder has at most :data:`DENSE_GIRDER_LIMIT` vertical DOFs, the block
 of the inverse effective matrix among them (its Green's function on the girder)
 is computed once, so a step needs two single-right-hand-side solves and a small
 gather instead of the m + 1 right-hand sides: the same equations, in another order
-of operations (equal to rounding).
+of operations (equal to rounding). With a lean integrator (every solver variant but
+``reference``) and numba installed, that step runs in the compiled kernels of
+:mod:`ttb_sim.sim.quarter_car_kernels`, again equal to rounding; the ``reference``
+variant keeps the numpy path, bit for bit.
 """
 
 from __future__ import annotations
+
+from typing import Any, Callable
 
 import numpy as np
 
 from ttb_sim.model.bridge import GirderLine, Structure
 from ttb_sim.model.constants import GRAVITY
 from ttb_sim.model.irregularity import TrackIrregularity
+from ttb_sim.model.irregularity._checks import GRID_SLACK
 from ttb_sim.model.vehicle.train import QuarterCars
+from ttb_sim.sim import quarter_car_kernels
 from ttb_sim.sim.coupling.base import girder_wheel_load, VehicleOutputs
 from ttb_sim.sim.integrators.protocol import Integrator
 
@@ -52,10 +59,14 @@ class QuarterCarCoupling:
 
     The vehicle state (sprung-mass displacement, velocity, acceleration, measured
     from static equilibrium) lives here; the girder state is passed in.
+
+    ``compiled`` chooses the compiled kernels of the Green's-function step: None
+    (the default) takes them when the integrator is lean and numba imports,
+    False never, True whenever numba imports.
     """
 
     def __init__(self, cars: QuarterCars, girder: GirderLine, integrator: Integrator,
-                 n_free: int) -> None:
+                 n_free: int, compiled: bool | None = None) -> None:
         self.cars = cars
         self.girder = girder
         self.nm = integrator
@@ -80,6 +91,26 @@ class QuarterCarCoupling:
         girder_dofs = girder_dofs[girder_dofs < n_free]
         if 0 < girder_dofs.size <= DENSE_GIRDER_LIMIT:
             self._green, self._slot = self._girder_green(girder_dofs)
+        if compiled is None:
+            compiled = bool(getattr(integrator, 'lean', False))
+        self.compiled = (compiled and self._green is not None
+                         and quarter_car_kernels.available())
+        """True when :meth:`step` runs the compiled kernels."""
+        self.element = np.zeros(n, dtype=np.intp)
+        """Element under each wheel at the latest compiled step."""
+        self.n0 = np.zeros((n, 4))
+        """Hermite rows of the deflection under each wheel at the latest compiled step."""
+        self._kernels: tuple[Callable[..., Any], ...] = ()
+        self.positions: np.ndarray | None = None
+        """Axle positions of the latest compiled step (None: none yet)."""
+        if self.compiled:
+            self._dofs = np.zeros((n, 4), dtype=girder.w_dofs.dtype)
+            self._w, self._p = np.zeros((n, 4)), np.zeros((n, 4))
+            self._b, self._e = np.zeros(n), np.zeros(n)
+            self._hs_v, self._hs_a = np.zeros(n), np.zeros(n)
+            found = (quarter_car_kernels.compiled(name) for name in (
+                'wheel_terms', 'green_correction', 'update_cars'))
+            self._kernels = tuple(k for k in found if k is not None)
 
     def _girder_green(self, girder_dofs: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """
@@ -123,6 +154,8 @@ class QuarterCarCoupling:
         :attr:`contact` (force of the girder on each wheel, N, up) are updated.
 
         """
+        if self.compiled:
+            return self._step_compiled(u, v, a, force, positions, speed, profile)
         nm, cars, n_free = self.nm, self.cars, self.n_free
         a0, a1 = nm.a0, nm.a1
         h_v, h_a = nm.history(u, v, a)
@@ -208,6 +241,32 @@ class QuarterCarCoupling:
         u_ext = np.append(nm.solve(base - unit[:n_free]), 0.0)
         return self._finish(u_ext, dofs, w, b, p, e, hs_v, hs_a, h_v, h_a)
 
+    def _step_compiled(self, u: np.ndarray, v: np.ndarray, a: np.ndarray, force: np.ndarray,
+                       positions: np.ndarray, speed: float,
+                       profile: tuple[np.ndarray, np.ndarray, np.ndarray] | None,
+                       ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """:meth:`step` with the Green's function, in the compiled kernels."""
+        nm, cars = self.nm, self.cars
+        wheel_terms, green_correction, update_cars = self._kernels
+        h_v, h_a = nm.history(u, v, a)
+        load = nm.effective_load(force, h_v, h_a)   # a new vector, ours to change
+        r, r1, r2 = profile if profile is not None else (self._b, self._b, self._b)
+        dofs, n0, w, p, b, e = self._dofs, self.n0, self._w, self._p, self._b, self._e
+        wheel_terms(positions, float(speed), self.girder.element_length,
+                    self.girder.n_spans * self.girder.elements_per_span, self.girder.length,
+                    self.girder.w_dofs, h_v, h_a, nm.a0, nm.a1, profile is not None,
+                    r, r1, r2, cars.sprung_mass, cars.unsprung_mass, cars.stiffness,
+                    cars.damping, self._d, self._q, self.z, self.v, self.a, GRAVITY,
+                    self.element, dofs, n0, w, p, b, e, self._hs_v, self._hs_a, load)
+        x0 = np.asarray(nm.solve(load))
+        green_correction(x0, self._green, self._slot, dofs, n0, w, load)
+        u_new = np.asarray(nm.solve(load))
+        update_cars(u_new, dofs, w, p, b, e, self._d, self._hs_v, self._hs_a, nm.a0, nm.a1,
+                    self.z, self.v, self.a, self.contact)
+        self.positions = positions
+        v_new, a_new = nm.finish(u_new, h_v, h_a)
+        return u_new, v_new, a_new
+
 
 class QuarterCarTrain:
     """
@@ -244,12 +303,21 @@ class QuarterCarTrain:
         self.v = np.zeros(n_free)
         self.a = np.zeros(n_free)
         self._zero = np.zeros(n_free)
+        n = cars.axles.count
+        self._r = (np.zeros(n), np.zeros(n), np.zeros(n))
+        self._profile_kernel = (quarter_car_kernels.compiled('centreline_profile')
+                                if self.kernel.compiled and irregularity is not None else None)
 
     def _profile(self, positions: np.ndarray
                  ) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
         """Return the centreline vertical irregularity r, r', r'' under the wheels."""
         if self.irregularity is None:
             return None
+        if self._profile_kernel is not None:
+            irr = self.irregularity
+            self._profile_kernel(positions, irr.x_start, irr.dx, irr.values, irr.slopes,
+                                 irr.curvatures, GRID_SLACK, *self._r)
+            return self._r
         s = self.irregularity.sample(positions, outside='zero')
         return (0.5 * (s.value[0] + s.value[1]), 0.5 * (s.slope[0] + s.slope[1]),
                 0.5 * (s.curvature[0] + s.curvature[1]))
@@ -273,7 +341,13 @@ class QuarterCarTrain:
 
     def structure_load(self, head: float) -> np.ndarray:
         """Return the wheel contact forces (the static loads at the start) on all DOFs."""
-        st = self.structure
+        st, kernel = self.structure, self.kernel
+        positions = head - self.cars.axles.offsets
+        if kernel.positions is not None and np.array_equal(kernel.positions, positions):
+            # The rows of the latest compiled step are those of these positions.
+            return np.bincount(st.girder.w_dofs_full[kernel.element].ravel(),
+                               weights=(-kernel.contact[:, None] * kernel.n0).ravel(),
+                               minlength=st.n_full)
         return girder_wheel_load(st.girder, st.n_full, head - self.cars.axles.offsets,
                                  self.kernel.contact)
 
