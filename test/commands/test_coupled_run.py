@@ -52,6 +52,11 @@ def test_coupled_bag_holds_bearing_pile_and_soil_streams(tmp_path):
     bearing = sum(arrays[f'/ttb_sim/bearings/pier03/{side}']['force'][:, 2]
                   for side in ('left', 'right'))
     assert bearing.min() < -1e5
+    # every head reports its own rotation rate (not a stub zero), small beside its settlement
+    rates = np.array([arrays[f'/ttb_sim/piles/pier03/pile{m:02d}/imu']['angular_velocity']
+                      for m in range(1, 16)])
+    assert (np.abs(rates).max(axis=(1, 2)) > 0).all()
+    assert np.abs(rates).max() < 1e-3               # rad/s, against mm/s of settlement rate
     soil = arrays['/ttb_sim/soil/points']['points']
     assert soil.shape[1] == 24                    # [P]'s line of 21 and the 3 VAL points
     assert np.allclose(soil[0, :, 0].mean(), 2 * 32.0, atol=6.0)   # under pier 3

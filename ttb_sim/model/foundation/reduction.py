@@ -91,7 +91,7 @@ BUILD_SECONDS_PER_DOF = 509.0 / (81_648 * 5)
 """CPU seconds per DOF and shift of a reduction, measured on the paper mesh (81 648 DOFs, five
 shifts, 509 s on this 2-core machine): the order of magnitude the first-build notice gives."""
 
-FORMAT = 1
+FORMAT = 2
 """Version of the reduction and of its cache files; part of the cache key."""
 FACTORIZATION = 'cholmod'
 """Factorisation of the shifted pencils (falls back as :func:`factorize` says)."""
@@ -290,6 +290,7 @@ def _build(spec: Substructure, pier_height: float, pier_elements: int,
     lead = n - phi.shape[1]
     model = tied.model
     heads = _rows(model.head_displacement, tied, phi, lead)
+    rotations = _rows(model.head_rotation, tied, phi, lead)
     points = _rows(model.soil_points.operator, tied, phi, lead)
     assert spec.piles is not None
     centre = np.array(spec.piles.centre, dtype=float)
@@ -308,7 +309,8 @@ def _build(spec: Substructure, pier_height: float, pier_elements: int,
                               soil_points=points, soil_point_names=model.soil_points.names,
                               soil_point_positions=soil_positions,
                               depth=float(pier_height + spec.cap.thickness), summary=summary,
-                              interface=_interface_rows(tied, phi, lead))
+                              interface=_interface_rows(tied, phi, lead),
+                              pile_rotations=rotations)
 
 
 def reduction_basis(tied: TiedSubstructure, reduction: ReductionParameters
@@ -593,7 +595,7 @@ def cache_key(spec: Substructure, pier_height: float, pier_elements: int,
 
 
 _ARRAYS = ('mass', 'damping', 'stiffness', 'pile_heads', 'pile_positions', 'soil_points',
-           'soil_point_positions')
+           'soil_point_positions', 'pile_rotations')
 _INTERFACE = ('normal', 'shear', 'sigma_n0', 'cohesion', 'tan_delta')
 
 
