@@ -45,7 +45,7 @@ import numpy as np
 
 COMPONENTS = 4
 """Contact force components per wheel: Fx, Fy, Fz, Mz."""
-HELPERS = ('_hermite', '_interp', '_interval', '_solve_in_place')
+HELPERS = ('_hermite', '_interp', '_interval', '_solve_in_place', 'quintic')
 """Functions the kernels call: :func:`ttb_sim.sim.kernels.compiled` compiles them first."""
 
 
@@ -279,18 +279,10 @@ def rail_irregularity(x: np.ndarray, side: np.ndarray, x_start: float, dx: float
             for q in range(2):
                 row = (0 if left else 1) if q == 0 else (2 if left else 3)
                 p0 = values[row, i]
-                p1 = values[row, i + 1]
                 m0 = dx * slopes[row, i]
-                m1 = dx * slopes[row, i + 1]
-                c0 = dx * dx * curvatures[row, i]
-                c1 = dx * dx * curvatures[row, i + 1]
-                a2 = 0.5 * c0
-                d0 = p1 - (p0 + m0 + a2)
-                d1 = m1 - (m0 + c0)
-                d2 = c1 - c0
-                a3 = 10.0 * d0 - 4.0 * d1 + 0.5 * d2
-                a4 = -15.0 * d0 + 7.0 * d1 - d2
-                a5 = 6.0 * d0 - 3.0 * d1 + 0.5 * d2
+                a2, a3, a4, a5 = quintic(p0, values[row, i + 1], m0, dx * slopes[row, i + 1],
+                                         dx * dx * curvatures[row, i],
+                                         dx * dx * curvatures[row, i + 1])
                 value = p0 + t * (m0 + t * (a2 + t * (a3 + t * (a4 + t * a5))))
                 if q == 0:
                     z[c, k] = value
@@ -298,6 +290,22 @@ def rail_irregularity(x: np.ndarray, side: np.ndarray, x_start: float, dx: float
                     y[c, k] = value
                     dy[c, k] = (m0 + t * (2.0 * a2 + t * (3.0 * a3 + t * (
                         4.0 * a4 + t * 5.0 * a5)))) / dx
+
+
+def quintic(p0: float, p1: float, m0: float, m1: float, c0: float,
+            c1: float) -> tuple[float, float, float, float]:
+    """
+    Return (a2, a3, a4, a5) of the quintic Hermite on [0, 1] through value p, slope m, curvature c.
+
+    p(t) = p0 + m0 t + a2 t^2 + ... + a5 t^5, the arithmetic of
+    :meth:`ttb_sim.model.irregularity.profile.TrackIrregularity.sample`.
+    """
+    a2 = 0.5 * c0
+    d0 = p1 - (p0 + m0 + a2)
+    d1 = m1 - (m0 + c0)
+    d2 = c1 - c0
+    return (a2, 10.0 * d0 - 4.0 * d1 + 0.5 * d2, -15.0 * d0 + 7.0 * d1 - d2,
+            6.0 * d0 - 3.0 * d1 + 0.5 * d2)
 
 
 def _interp(y: float, grid: np.ndarray, j: int, column: np.ndarray) -> float:

@@ -35,29 +35,33 @@ log = logging.getLogger(__name__)
 
 ENABLED = True
 """False makes :func:`compiled` return None, so the lean step takes the numpy twins."""
-_CACHE: dict[str, Callable[..., Any] | None] = {}
+_CACHE: dict[Callable[..., Any], Callable[..., Any] | None] = {}
 
 
 def compiled(name: str) -> Callable[..., Any] | None:
+    """Return the compiled lean-step kernel ``name`` (compiled on first call), or None."""
+    return jit(_KERNELS[name])
+
+
+def jit(kernel: Callable[..., Any]) -> Callable[..., Any] | None:
     """
-    Return the compiled kernel ``name`` (compiled on first call), or None.
+    Return ``kernel`` compiled by numba (on first call, with its module's helpers), or None.
 
     None when numba is not installed or :data:`ENABLED` is False; numba is
     imported only here, so the package imports without it and quickly.
     """
     if not ENABLED:
         return None
-    if name not in _CACHE:
+    if kernel not in _CACHE:
         try:
             import numba
         except ImportError:  # pragma: no cover - depends on the installation
             log.debug('numba is not installed; the lean step runs its numpy twins')
-            _CACHE[name] = None
+            _CACHE[kernel] = None
         else:
-            kernel = _KERNELS[name]
             _jit_helpers(numba, kernel)
-            _CACHE[name] = numba.njit(cache=True, nogil=True)(kernel)
-    return _CACHE[name]
+            _CACHE[kernel] = numba.njit(cache=True, nogil=True)(kernel)
+    return _CACHE[kernel]
 
 
 def _jit_helpers(numba: Any, kernel: Callable[..., Any]) -> None:

@@ -287,8 +287,8 @@ class RigidDisplacement:
     def __init__(self, structure: Structure) -> None:
         self.n_spans = structure.girder.n_spans
         piled = [p.support for p in structure.piled]
-        self.spans = sorted({s - 1 for s in piled} | set(piled))
-        self.spans = [k for k in self.spans if 0 <= k < self.n_spans]
+        # the girders resting on a piled support: the spans on either side of it
+        self.spans = sorted({k for s in piled for k in (s - 1, s) if 0 <= k < self.n_spans})
         counts = [p.operator.n_piles for p in structure.piled]
         rows = np.split(np.arange(sum(counts)), np.cumsum(counts)[:-1])
         self._slices = dict(zip(piled, rows))

@@ -43,35 +43,19 @@ directory is writable).
 
 from __future__ import annotations
 
-import logging
 from typing import Any, Callable
 
 import numpy as np
 from ttb_sim.sim import kernels
+from ttb_sim.sim.contact_kernels import quintic
 
-log = logging.getLogger(__name__)
-
-_CACHE: dict[str, Callable[..., Any] | None] = {}
+HELPERS = ('quintic',)
+"""Functions the kernels call: :func:`ttb_sim.sim.kernels.jit` compiles them first."""
 
 
 def compiled(name: str) -> Callable[..., Any] | None:
-    """
-    Return the compiled kernel ``name`` (compiled on first call), or None.
-
-    None when numba is not installed or :data:`ttb_sim.sim.kernels.ENABLED` is
-    False (the switch of every compiled kernel); numba is imported only here.
-    """
-    if not kernels.ENABLED:
-        return None
-    if name not in _CACHE:
-        try:
-            import numba
-        except ImportError:  # pragma: no cover - depends on the installation
-            log.debug('numba is not installed; the quarter-car step runs its numpy path')
-            _CACHE[name] = None
-        else:
-            _CACHE[name] = numba.njit(cache=True, nogil=True)(_KERNELS[name])
-    return _CACHE[name]
+    """Return the compiled quarter-car kernel ``name`` (:func:`ttb_sim.sim.kernels.jit`)."""
+    return kernels.jit(_KERNELS[name])
 
 
 def available() -> bool:
@@ -104,18 +88,10 @@ def _centreline_profile(x: np.ndarray, x_start: float, dx: float, values: np.nda
         curvature = 0.0
         for rail in range(2):
             p0 = values[rail, i]
-            p1 = values[rail, i + 1]
             m0 = h * slopes[rail, i]
-            m1 = h * slopes[rail, i + 1]
-            c0 = h * h * curvatures[rail, i]
-            c1 = h * h * curvatures[rail, i + 1]
-            a2 = 0.5 * c0
-            d0 = p1 - (p0 + m0 + a2)
-            d1 = m1 - (m0 + c0)
-            d2 = c1 - c0
-            a3 = 10.0 * d0 - 4.0 * d1 + 0.5 * d2
-            a4 = -15.0 * d0 + 7.0 * d1 - d2
-            a5 = 6.0 * d0 - 3.0 * d1 + 0.5 * d2
+            a2, a3, a4, a5 = quintic(p0, values[rail, i + 1], m0, h * slopes[rail, i + 1],
+                                     h * h * curvatures[rail, i],
+                                     h * h * curvatures[rail, i + 1])
             value += p0 + t * (m0 + t * (a2 + t * (a3 + t * (a4 + t * a5))))
             slope += (m0 + t * (2.0 * a2 + t * (3.0 * a3 + t * (4.0 * a4 + t * 5.0 * a5)))) / h
             curvature += (2.0 * a2 + t * (6.0 * a3 + t * (12.0 * a4 + t * 20.0 * a5))) / (h * h)
