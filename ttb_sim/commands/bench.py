@@ -42,11 +42,11 @@ every variant several times, interleaved, and keeps the fastest.
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 import json
 import logging
 import math
 import os
-from dataclasses import dataclass
 from pathlib import Path
 import subprocess
 import sys
@@ -60,7 +60,6 @@ from ttb_sim.errors import DivergenceError, ScenarioError, SimulationError
 from ttb_sim.inputs import shown
 
 log = logging.getLogger(__name__)
-
 
 
 @dataclass(frozen=True)
@@ -353,7 +352,9 @@ def worker(argv: Sequence[str] | None = None) -> int:
     except ScenarioError as exc:
         sys.stderr.write(f'{exc}\n')
         return 2
-    np.savez(job['traces'], **traces)
+    np.savez(job['traces'], wheel_rail_vertical=traces['wheel_rail_vertical'],
+             wheel_rail_lateral=traces['wheel_rail_lateral'], midspan=traces['midspan'],
+             pile_heads=traces['pile_heads'])
     sys.stdout.write(json.dumps(metrics) + '\n')
     return 0
 
