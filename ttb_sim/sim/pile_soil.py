@@ -417,8 +417,11 @@ def static_solve(model: PileSoilModel, force: np.ndarray, increments: int = 5,
     cap and interface block exactly (factorised once, by ``factorization`` as
     in :class:`PartitionedNewmark`) and the soil diagonal, so the stiffness
     contrast between piles and soil costs nothing and the whole 3-D soil is
-    never factorised. ``direct=True`` instead factorises the whole tangent of
-    every iteration (the reference path, for models small enough).
+    never factorised. ``direct=True`` instead solves each iteration with a
+    direct factorisation of the whole initial tangent (modified Newton, the
+    current tangent refactorised when an increment needs more than 15
+    iterations, as :class:`PartitionedNewmark`): the reference path, for
+    models small enough.
 
     Raises
     ------
@@ -450,9 +453,12 @@ def static_solve(model: PileSoilModel, force: np.ndarray, increments: int = 5,
     u = state.u.copy()
     slip = state.slip
     scale = max(float(np.linalg.norm(force)), 1e-30)
+    # direct: modified Newton on the initial tangent, refactorised at the current tangent
+    # when an increment needs more than 15 iterations (as PartitionedNewmark)
+    direct_factor = _Factor(k0) if direct else None
     for step in range(1, increments + 1):
         target = force * step / increments
-        for _ in range(max_iterations):
+        for it in range(max_iterations):
             f_ifc, tangent, _ = _interface_response(model, u, slip)
             residual = target[free] - k_lin_free @ u[free] - f_ifc[free]
             if np.linalg.norm(residual) <= tolerance * scale:
@@ -461,8 +467,10 @@ def static_solve(model: PileSoilModel, force: np.ndarray, increments: int = 5,
             if tangent is not None:
                 assert model.interface is not None
                 k_t = k_lin_free + model.interface.stiffness(tangent)[free][:, free]
-            if direct:
-                du = _Factor(k_t).solve(residual)
+            if direct_factor is not None:
+                if it > 0 and it % 15 == 0:
+                    direct_factor = _Factor(k_t)
+                du = direct_factor.solve(residual)
             else:
                 du, info = sla.cg(k_t, residual, M=preconditioner, maxiter=20 * len(free),
                                   **{_CG_TOLERANCE: cg_tolerance})
