@@ -70,8 +70,9 @@ def _parser() -> argparse.ArgumentParser:
     be = sub.add_parser('bench', help='time the solver variants side by side and compare '
                         'their results with the reference variant')
     be.add_argument('scenarios', nargs='*', metavar='SCENARIO',
-                    help='YAML paths or built-in names (default: ten_span_train, and '
-                    'paper_ttbi for 0.05 s)')
+                    help='YAML paths or built-in names (default: ten_span_train; '
+                    'paper_ttbi and paper_ttbcpsi for 0.05 s; single_pile, 5 Hz harmonic, '
+                    'for 0.2 s; pile_harmonic for 0.02 s)')
     be.add_argument('--duration', type=float, help='simulated time of every scenario (s)')
     be.add_argument('--variants', help='comma-separated solver.variant values (default: all; '
                     'reference always runs, as the comparison base)')

@@ -21,6 +21,7 @@ the machine.
 import json
 from pathlib import Path
 
+import numpy as np
 import pytest
 from ttb_sim.cli import main
 from ttb_sim.commands import bench as bn
@@ -102,3 +103,86 @@ def test_run_unknown_variant_exit_2(tmp_path: Path, capsys):
     err = capsys.readouterr().err
     assert "solver.variant = 'turbo'" in err and "'reference'" in err
     assert not out.exists()
+
+
+PILE = ['soil.block.lx=12', 'soil.block.ly=12', 'soil.mesh.h=0.8', 'soil.mesh.growth=1.5',
+        'soil.mesh.h_max=2.5', 'piles.side=0.8', 'piles.length=6', 'load.frequency=4',
+        'output.rate_hz=200', 'output.soil_points=[[2.0, 0.0, 0.0]]']
+"""The built-in single_pile workload (harmonic) on a coarse mesh: 6 120 DOFs, 1 573 bricks."""
+SUBSTRUCTURE_DOFS = {'soil', 'piles', 'cap', 'interface', 'boundary', 'total', 'solved'}
+
+
+def _pile_model():
+    from ttb_sim.config import load_scenario
+    from ttb_sim.model.foundation.substructure import build
+
+    scenario = load_scenario('single_pile', PILE)
+    return scenario, build(scenario.substructure('pier01'))
+
+
+def test_substructure_workload_rows_dof_counts_and_difference():
+    report = bn.bench(['single_pile'], ['qdldl'], 0.5, isolate=False, overrides=PILE)
+    ref, fast = report['runs']
+    scenario, model = _pile_model()
+    assert [ref['variant'], fast['variant']] == ['reference', 'qdldl']
+    assert [ref['scheme'], fast['scheme']] == ['implicit', 'mixed']
+    for run in (ref, fast):
+        assert run['status'] == 'ok' and run['model'] == 'pile_soil'
+        assert run['load'] == 'harmonic'  # the workload's own override
+        assert set(run['dofs']) == SUBSTRUCTURE_DOFS
+        assert run['dt'] == pytest.approx(5e-3) and run['steps'] == 100
+        # counts from the mesh, independently of the model's matrices
+        nodes = model.mesh.nodes
+        assert run['dofs']['total'] == 3 * len(nodes)
+        half = 0.5 * scenario.soil.block.lx
+        outer = ((np.abs(np.abs(nodes[:, 0]) - half) < 1e-9)
+                 | (np.abs(np.abs(nodes[:, 1]) - half) < 1e-9)
+                 | (np.abs(nodes[:, 2] + scenario.soil.depth) < 1e-9))
+        assert run['dofs']['boundary'] == 3 * int(outer.sum())
+        pile_cells = int(model.summary['pile_cells'])  # one brick across the 0.8 m pile
+        assert run['dofs']['piles'] == 3 * 4 * (pile_cells + 1)
+        assert run['dofs']['cap'] == 0 and run['dofs']['interface'] > run['dofs']['piles']
+        assert run['bricks'] == len(model.mesh.cells)
+        assert run['cpu_us_per_brick_step'] == pytest.approx(
+            1e3 * run['cpu_ms_per_step'] / run['bricks'], rel=1e-9)
+        for name in ('wheel_rail_vertical', 'wheel_rail_lateral', 'midspan'):
+            assert run['difference'][name]['rms'] is None
+    assert ref['dofs']['solved'] == ref['dofs']['total']
+    assert 0 < fast['dofs']['solved'] < fast['dofs']['total']
+    assert ref['difference']['pile_heads']['rms'] == 0.0
+    # implicit against mixed soil at 4 Hz, dt = 5 ms over two load periods: a
+    # time-discretisation difference, at most zeta omega dt + (omega dt)^2 / 4 = 1 %
+    # (test/sim/test_substructure_variants.py)
+    assert 0 < fast['difference']['pile_heads']['rms_rel'] < 0.01
+    table = bn.format_table(report)
+    assert 'µs/brick' in table and table.count('single_pile') == 2
+    json.dumps(report)
+
+
+def test_a_refused_reference_leaves_the_other_variants_running(monkeypatch):
+    from ttb_sim.sim import substructure_run
+
+    monkeypatch.setattr(substructure_run, 'IMPLICIT_MAX_DOFS', 1000)
+    report = bn.bench(['single_pile'], ['qdldl'], 0.01, isolate=False, overrides=PILE)
+    ref, fast = report['runs']
+    assert ref['status'] == 'refused' and ref['variant'] == 'reference'
+    assert ref['message'].startswith("solver.variant = 'reference': ")
+    assert fast['status'] == 'ok' and fast['difference']['pile_heads']['rms'] is None
+    table = bn.format_table(report)
+    assert 'refused: solver.variant' in table
+    json.dumps(report)
+
+
+def test_isolated_substructure_runs_return_the_pile_heads():
+    report = bn.bench(['single_pile'], ['cholmod'], 0.01, overrides=PILE)
+    ref, fast = report['runs']
+    assert ref['difference']['pile_heads']['rms'] == 0.0
+    assert fast['difference']['pile_heads']['rms_rel'] is not None
+    assert fast['peak_rss_mib'] > 0 and fast['factorization'] == 'cholmod'
+
+
+def test_cli_bad_scenario_exit_2_before_any_run(capsys):
+    assert main(['bench', 'single_pile', 'no_such_scenario', '--in-process']) == 2
+    err = capsys.readouterr().err
+    assert 'no_such_scenario' in err and 'bench: single_pile' not in err
+    assert err.strip().count('\n') == 0

@@ -23,7 +23,15 @@ the time step, the build time (assembly and factorisation), the start time
 step (wall and CPU time of the process: on a shared machine the CPU time is the
 steadier of the two), the real-time factor of the stepping (simulated time /
 stepping wall time), the peak memory, and the RMS and peak difference from the ``reference``
-variant of the wheel-rail forces and the girder mid-span displacements.
+variant of the wheel-rail forces, the girder mid-span displacements and the pile-head
+displacements.
+
+A pile-soil substructure on its own (``single_pile``, ``pile_harmonic``: a
+scenario whose ``load.type`` is set) is measured through the same functions:
+its DOF counts are those of the soil, piles, cap, interface and boundary, and
+the report adds the bricks and the CPU microseconds per brick per step. Where
+the ``reference`` variant (fully implicit) is refused for the size of the mesh,
+the other variants run alone and the table says so.
 
 What is timed is the stepping core and the frames it yields; writing a bag
 is not included (``ttb-sim run`` reports its own wall time with the bag).
@@ -34,6 +42,7 @@ every variant several times, interleaved, and keeps the fastest.
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 import json
 import logging
 import math
@@ -52,9 +61,30 @@ from ttb_sim.inputs import shown
 
 log = logging.getLogger(__name__)
 
-DEFAULT_WORKLOADS: dict[str, float | None] = {'ten_span_train': None, 'paper_ttbi': 0.05,
-                                              'paper_ttbcpsi': 0.05}
-"""Built-in workloads and their default simulated time (s; None = the scenario's own)."""
+
+@dataclass(frozen=True)
+class Workload:
+    """Default settings of a built-in workload."""
+
+    duration: float | None = None
+    """Simulated time (s); None = the scenario's own."""
+    overrides: tuple[str, ...] = ()
+    """``KEY=VALUE`` overrides applied before the user's."""
+    variants: tuple[str, ...] = ()
+    """Variants run when none are named (empty = all)."""
+
+
+DEFAULT_WORKLOADS: dict[str, Workload] = {
+    'ten_span_train': Workload(),
+    'paper_ttbi': Workload(0.05),
+    'paper_ttbcpsi': Workload(0.05),
+    'single_pile': Workload(0.2, ('load.type=harmonic', 'load.frequency=5')),
+    'pile_harmonic': Workload(0.02, variants=('qdldl',)),
+}
+"""Built-in workloads: ``single_pile`` under a 5 Hz harmonic head load for 0.2 s (every
+variant; ``reference`` steps it fully implicit); ``pile_harmonic`` (752 k DOFs, too large for
+the implicit ``reference``) for 20 steps with the default variant alone, since every other
+variant runs the same mixed scheme and differs only in the small pile-block factorisation."""
 REFERENCE = 'reference'
 """The variant every other one is compared with."""
 QUANTITIES = ('wheel_rail_vertical', 'wheel_rail_lateral', 'midspan', 'pile_heads')
@@ -133,10 +163,45 @@ def _peak_rss_mib() -> float | None:
     return peak * scale / 2**20
 
 
+def _substructure_dof_counts(run: Any) -> dict[str, int]:
+    """
+    DOF counts of a pile-soil substructure run, per subsystem.
+
+    Free DOFs of the nodes of soil, pile and cap bricks, of the interface
+    elements and of the boundary springs and dashpots (a node shared by two
+    subsystems counts in both); ``total`` is every free DOF and ``solved`` those
+    the step (or the static solve) factorises: all of them in the implicit
+    scheme, the piles, cap and interface in the mixed one.
+    """
+    from ttb_sim.model.foundation.substructure import CAP, PILE, SOIL
+    from ttb_sim.sim.pile_soil import implicit_dofs
+
+    model = run.model
+    free = model.free
+
+    def of_cells(kind: int) -> int:
+        nodes = np.unique(model.mesh.cells[model.cell_kind == kind])
+        dofs = (3 * nodes[:, None] + np.arange(3)).ravel()
+        return int(np.count_nonzero(free[dofs]))
+
+    interface = 0
+    if model.interface is not None:
+        touched = np.unique(model.interface.relative.indices)
+        interface = int(np.count_nonzero(free[touched]))
+    boundary = (model.boundary_stiffness.diagonal() != 0) | (model.boundary_damping.diagonal()
+                                                             != 0)
+    total = int(np.count_nonzero(free))
+    solved = total if run.scheme == 'implicit' else int(np.count_nonzero(implicit_dofs(model)
+                                                                         & free))
+    return {'soil': of_cells(SOIL), 'piles': of_cells(PILE), 'cap': of_cells(CAP),
+            'interface': interface, 'boundary': int(np.count_nonzero(boundary & free)),
+            'total': total, 'solved': solved}
+
+
 def measure(scenario: str, variant: str, duration: float | None = None,
             overrides: Sequence[str] = ()) -> tuple[dict[str, Any], Traces]:
     """
-    Build and step one passage in this process.
+    Build and step one passage (or one substructure run) in this process.
 
     Parameters
     ----------
@@ -158,18 +223,18 @@ def measure(scenario: str, variant: str, duration: float | None = None,
     Raises
     ------
     ScenarioError
-        For a bad scenario, key or value.
+        For a bad scenario, key or value, or a variant refused for the model's size.
 
     """
     from ttb_sim.config import load_scenario
-    from ttb_sim.sim.simulation import Simulation
+    from ttb_sim.sim.runner import make_runner
 
     values: list[tuple[str, Any]] = [('solver.variant', variant)]
     if duration is not None:
         values.append(('solver.duration', duration))
     loaded = load_scenario(scenario, overrides, values)
     t0 = time.perf_counter()
-    sim = Simulation(loaded)
+    sim: Any = make_runner(loaded)
     t1 = time.perf_counter()
     vertical: list[np.ndarray] = []
     lateral: list[np.ndarray] = []
@@ -196,13 +261,19 @@ def measure(scenario: str, variant: str, duration: float | None = None,
     steps = max(frames - 1, 0) * sim.output_every
     stepping = t3 - t2
     simulated = steps * sim.dt
+    substructure = loaded.substructure_only
+    bricks = len(sim.model.mesh.cells) if substructure else None
     metrics: dict[str, Any] = {
         'scenario': loaded.name,
         'variant': variant,
-        'factorization': sim.integrator.method,
+        'model': 'pile_soil' if substructure else 'train_bridge',
+        'load': sim.load.type if substructure else None,
+        'scheme': sim.scheme if substructure else None,
+        'factorization': sim.factorization if substructure else sim.integrator.method,
         'status': status,
         'message': message,
-        'dofs': _dof_counts(sim),
+        'dofs': _substructure_dof_counts(sim) if substructure else _dof_counts(sim),
+        'bricks': bricks,
         'dt': sim.dt,
         'steps': steps,
         'frames': frames,
@@ -212,7 +283,9 @@ def measure(scenario: str, variant: str, duration: float | None = None,
         'step_time': stepping,
         'ms_per_step': 1e3 * stepping / steps if steps else None,
         'cpu_ms_per_step': 1e3 * cpu / steps if steps else None,
-        'real_time_factor': simulated / stepping if stepping > 0 else None,
+        'us_per_brick_step': 1e6 * stepping / (steps * bricks) if steps and bricks else None,
+        'cpu_us_per_brick_step': 1e6 * cpu / (steps * bricks) if steps and bricks else None,
+        'real_time_factor': simulated / stepping if stepping > 0 and steps else None,
         'peak_rss_mib': _peak_rss_mib(),
     }
     traces = {'wheel_rail_vertical': _stack(vertical), 'wheel_rail_lateral': _stack(lateral),
@@ -280,7 +353,8 @@ def worker(argv: Sequence[str] | None = None) -> int:
         sys.stderr.write(f'{exc}\n')
         return 2
     np.savez(job['traces'], wheel_rail_vertical=traces['wheel_rail_vertical'],
-             wheel_rail_lateral=traces['wheel_rail_lateral'], midspan=traces['midspan'])
+             wheel_rail_lateral=traces['wheel_rail_lateral'], midspan=traces['midspan'],
+             pile_heads=traces['pile_heads'])
     sys.stdout.write(json.dumps(metrics) + '\n')
     return 0
 
@@ -324,13 +398,16 @@ def bench(scenarios: Sequence[str] = (), variants: Sequence[str] = (),
     scenarios : sequence of str
         Built-in names or YAML paths; empty = :data:`DEFAULT_WORKLOADS`.
     variants : sequence of str
-        Values of ``solver.variant``; empty = all. ``reference`` always runs
-        (first), since the others are compared with it.
+        Values of ``solver.variant``; empty = all (or the workload's own
+        default, :data:`DEFAULT_WORKLOADS`). ``reference`` always runs (first),
+        since the others are compared with it, unless it is refused for the
+        workload's size: then its row has status 'refused' and the message.
     duration : float, optional
         Simulated time of every workload (s); None = the workload's default
         (:data:`DEFAULT_WORKLOADS`, or the scenario's own).
     overrides : sequence of str
-        ``KEY=VALUE`` overrides applied to every workload.
+        ``KEY=VALUE`` overrides applied to every workload (after a built-in
+        workload's own).
     repeat : int
         Rounds; every variant runs once per round (interleaved) and the
         fastest stepping is kept.
@@ -349,33 +426,77 @@ def bench(scenarios: Sequence[str] = (), variants: Sequence[str] = (),
     Raises
     ------
     ScenarioError
-        For an unknown variant, a bad scenario or a bad ``repeat``.
+        For an unknown variant, a bad scenario or a bad ``repeat`` (every
+        workload is checked before the first run).
 
     """
-    names = check_variants(variants or variant_names())
+    check_variants(variants or variant_names())
     if repeat < 1:
         raise ScenarioError(f'--repeat = {repeat}: must be at least 1')
-    workloads = ([(s, DEFAULT_WORKLOADS.get(s)) for s in scenarios] if scenarios
-                 else list(DEFAULT_WORKLOADS.items()))
+    named = scenarios or tuple(DEFAULT_WORKLOADS)
+    plans = [_plan(s, variants, duration, overrides) for s in named]
     run = measure_isolated if isolate else measure
     runs: list[dict[str, Any]] = []
-    for scenario, default_duration in workloads:
-        span = duration if duration is not None else default_duration
+    for plan in plans:
+        scenario, names, span, sets, refusal = (plan.scenario, plan.variants, plan.duration,
+                                                plan.overrides, plan.refusal)
         best: dict[str, tuple[dict[str, Any], Traces]] = {}
         for _round in range(repeat):
             for name in names:
+                if name == REFERENCE and refusal is not None:
+                    continue
                 if progress is not None:
                     progress(f'{scenario} / {name}')
-                metrics, traces = run(scenario, name, span, overrides)
+                metrics, traces = run(scenario, name, span, sets)
                 kept = best.get(name)
                 if kept is None or _faster(metrics, kept[0]):
                     best[name] = (metrics, traces if kept is None else kept[1])
-        reference = best[REFERENCE][1]
+        reference = best[REFERENCE][1] if REFERENCE in best else {}
         for name in names:
+            if name not in best:
+                runs.append(_refused(plan.name, name, refusal or ''))
+                continue
             metrics, traces = best[name]
             metrics['difference'] = compare(traces, reference)
             runs.append(metrics)
     return {'machine': machine(), 'runs': runs}
+
+
+@dataclass(frozen=True)
+class _Plan:
+    """One workload, checked."""
+
+    scenario: str
+    name: str
+    variants: list[str]
+    duration: float | None
+    overrides: list[str]
+    refusal: str | None
+    """Why ``reference`` is refused for this workload (None: it runs)."""
+
+
+def _plan(scenario: str, variants: Sequence[str], duration: float | None,
+          overrides: Sequence[str]) -> _Plan:
+    """Check one workload before anything runs (a bad scenario raises ScenarioError)."""
+    from ttb_sim.config import load_scenario
+    from ttb_sim.sim.substructure_run import reference_refusal
+
+    workload = DEFAULT_WORKLOADS.get(scenario, Workload())
+    names = check_variants(variants or workload.variants or variant_names())
+    span = duration if duration is not None else workload.duration
+    sets = [*workload.overrides, *overrides]
+    values: list[tuple[str, Any]] = [('solver.variant', REFERENCE)]
+    if span is not None:
+        values.append(('solver.duration', span))
+    loaded = load_scenario(scenario, sets, values)
+    return _Plan(scenario, loaded.name, names, span, sets, reference_refusal(loaded))
+
+
+def _refused(name: str, variant: str, message: str) -> dict[str, Any]:
+    """Return the report row of a variant refused for the workload."""
+    return {'scenario': name, 'variant': variant, 'status': 'refused', 'message': message,
+            'difference': {q: {'rms': None, 'peak': None, 'rms_rel': None, 'peak_rel': None}
+                           for q in QUANTITIES}}
 
 
 def _faster(a: dict[str, Any], b: dict[str, Any]) -> bool:
@@ -422,10 +543,13 @@ def format_table(report: dict[str, Any]) -> str:
             f'{"dt s":>7s} '
             f'{"steps":>6s} {"build s":>7s} {"start s":>7s} {"ms/step":>8s} {"CPU ms":>8s} '
             f'{"RTF":>8s} {"peak MiB":>8s} {"Fz RMS %":>9s} {"Fy RMS %":>9s} '
-            f'{"mid RMS %":>9s} {"mid peak m":>10s} {"pile RMS %":>10s}')
+            f'{"mid RMS %":>9s} {"mid peak m":>10s} {"pile RMS %":>10s} {"µs/brick":>8s}')
     lines = [head, '-' * len(head)]
     for r in report['runs']:
         d = r['difference']
+        if r['status'] == 'refused':
+            lines.append(f'{r["scenario"]:17s} {r["variant"]:11s} refused: {r["message"]}')
+            continue
 
         def pct(name: str) -> str:
             rel = d[name]['rms_rel']
@@ -439,7 +563,8 @@ def format_table(report: dict[str, Any]) -> str:
             f'{_fmt(r["cpu_ms_per_step"], "8.3f")} '
             f'{_fmt(r["real_time_factor"], "8.3g")} {_fmt(r["peak_rss_mib"], "8.0f")} '
             f'{pct("wheel_rail_vertical")} {pct("wheel_rail_lateral")} {pct("midspan")} '
-            f'{_fmt(d["midspan"]["peak"], "10.2g")} {pct("pile_heads"):>10s}{status}')
+            f'{_fmt(d["midspan"]["peak"], "10.2g")} {pct("pile_heads"):>10s} '
+            f'{_fmt(r.get("cpu_us_per_brick_step"), "8.3f")}{status}')
     return '\n'.join(lines)
 
 

@@ -66,6 +66,7 @@ import scipy.sparse.linalg as sla
 
 from ttb_sim.errors import DivergenceError, SimulationError
 from ttb_sim.fe import hex8
+from ttb_sim.fe.factorization import Factorization, factorize
 from ttb_sim.model.foundation.substructure import PileSoilModel, rayleigh_coefficients
 
 LOG = logging.getLogger(__name__)
@@ -123,23 +124,38 @@ def observe(model: PileSoilModel, state: State) -> PileSoilFrame:
 
 
 class _Factor:
-    """A once-factorised symmetric positive definite matrix (CHOLMOD via cholespy or splu)."""
+    """
+    A once-factorised symmetric positive definite matrix.
 
-    def __init__(self, matrix: sp.spmatrix) -> None:
+    ``method`` None is this module's own choice (CHOLMOD via cholespy, else
+    SuperLU with minimum degree on A^T + A); otherwise a method of
+    :func:`ttb_sim.fe.factorization.factorize` (a solver variant's).
+    """
+
+    def __init__(self, matrix: sp.spmatrix, method: Optional[str] = None) -> None:
         a = sp.csr_matrix(matrix)
         self.n = a.shape[0]
+        self._chol = None
+        self._lu = None
+        self._other: Optional[Factorization] = None
+        if method is not None:
+            self._other = factorize(a, method=method)
+            self.method = self._other.method
+            return
         try:
             from cholespy import CholeskySolverD, MatrixType
             a.sort_indices()
             self._chol = CholeskySolverD(self.n, a.indptr.astype(np.int32),
                                          a.indices.astype(np.int32), a.data.astype(float),
                                          MatrixType.CSR)
-            self._lu = None
+            self.method = 'cholmod'
         except ImportError:  # pragma: no cover - cholespy is optional
-            self._chol = None
             self._lu = sla.splu(a.tocsc(), permc_spec='MMD_AT_PLUS_A')
+            self.method = 'superlu'
 
     def solve(self, b: np.ndarray) -> np.ndarray:
+        if self._other is not None:
+            return self._other.solve(np.ascontiguousarray(b, dtype=float))
         if self._chol is not None:
             x = np.zeros_like(b, dtype=float)
             self._chol.solve(np.ascontiguousarray(b, dtype=float), x)
@@ -244,14 +260,19 @@ class PartitionedNewmark:
         Relative residual at which the Newton iterations stop.
     max_iterations : int
         Iterations per step before a :class:`~ttb_sim.errors.SimulationError`.
+    factorization : str, optional
+        Method of :func:`ttb_sim.fe.factorization.factorize` for the implicit
+        block; None = CHOLMOD via cholespy, else SuperLU.
 
     """
 
     def __init__(self, model: PileSoilModel, dt: float,
                  scheme: Literal['mixed', 'implicit'] = 'mixed',
                  newton: Literal['modified', 'full'] = 'modified',
-                 tolerance: float = 1e-6, max_iterations: int = 100) -> None:
+                 tolerance: float = 1e-6, max_iterations: int = 100,
+                 factorization: Optional[str] = None) -> None:
         self.model = model
+        self.factorization = factorization
         self.dt = float(dt)
         self.scheme = scheme
         self.newton = newton
@@ -298,7 +319,9 @@ class PartitionedNewmark:
         self.m_e = model.mass[self.explicit]
         k0 = model.initial_interface_stiffness()[idx][:, idx]
         self._k_ifc0 = k0
-        self._factor = _Factor(self._matrix(k0))
+        self._factor = _Factor(self._matrix(k0), factorization)
+        self.method = self._factor.method
+        """Factorisation method actually used."""
         self.iterations = 0
 
     def _matrix(self, k_ifc: sp.spmatrix) -> sp.csr_matrix:
@@ -345,7 +368,7 @@ class PartitionedNewmark:
                 if refresh and tangent is not None:
                     assert model.interface is not None
                     k_t = model.interface.stiffness(tangent)[idx][:, idx]
-                    factor = _Factor(self._matrix(k_t))
+                    factor = _Factor(self._matrix(k_t), self.factorization)
             a_i = a_i + factor.solve(residual)
             self.iterations += 1
             if not nonlinear:
@@ -383,16 +406,22 @@ def implicit_dofs(model: PileSoilModel) -> np.ndarray:
 
 def static_solve(model: PileSoilModel, force: np.ndarray, increments: int = 5,
                  tolerance: float = 1e-6, max_iterations: int = 50,
-                 cg_tolerance: float = 1e-10) -> State:
+                 cg_tolerance: float = 1e-10, direct: bool = False,
+                 factorization: Optional[str] = None) -> State:
     """
     Return the static state under ``force`` (N), applied in equal increments.
 
     [P] section 2.4: each increment is iterated to equilibrium and the slip
     committed. Each Newton iteration (current interface tangent) is solved by
     preconditioned conjugate gradients: the preconditioner inverts the pile,
-    cap and interface block exactly (factorised once) and the soil diagonal,
-    so the stiffness contrast between piles and soil costs nothing and the
-    whole 3-D soil is never factorised.
+    cap and interface block exactly (factorised once, by ``factorization`` as
+    in :class:`PartitionedNewmark`) and the soil diagonal, so the stiffness
+    contrast between piles and soil costs nothing and the whole 3-D soil is
+    never factorised. ``direct=True`` instead solves each iteration with a
+    direct factorisation of the whole initial tangent (modified Newton, the
+    current tangent refactorised when an increment needs more than 15
+    iterations, as :class:`PartitionedNewmark`): the reference path, for
+    models small enough.
 
     Raises
     ------
@@ -410,7 +439,8 @@ def static_solve(model: PileSoilModel, force: np.ndarray, increments: int = 5,
     k0 = (k_lin + model.initial_interface_stiffness()).tocsr()[free][:, free]
     block = np.flatnonzero(implicit_dofs(model)[free])
     diagonal = k0.diagonal()
-    block_factor = _Factor(k0[block][:, block]) if len(block) else None
+    block_factor = (_Factor(k0[block][:, block], factorization)
+                    if len(block) and not direct else None)
 
     def precondition(r: np.ndarray) -> np.ndarray:
         x = r / diagonal
@@ -423,9 +453,12 @@ def static_solve(model: PileSoilModel, force: np.ndarray, increments: int = 5,
     u = state.u.copy()
     slip = state.slip
     scale = max(float(np.linalg.norm(force)), 1e-30)
+    # direct: modified Newton on the initial tangent, refactorised at the current tangent
+    # when an increment needs more than 15 iterations (as PartitionedNewmark)
+    direct_factor = _Factor(k0) if direct else None
     for step in range(1, increments + 1):
         target = force * step / increments
-        for _ in range(max_iterations):
+        for it in range(max_iterations):
             f_ifc, tangent, _ = _interface_response(model, u, slip)
             residual = target[free] - k_lin_free @ u[free] - f_ifc[free]
             if np.linalg.norm(residual) <= tolerance * scale:
@@ -434,10 +467,15 @@ def static_solve(model: PileSoilModel, force: np.ndarray, increments: int = 5,
             if tangent is not None:
                 assert model.interface is not None
                 k_t = k_lin_free + model.interface.stiffness(tangent)[free][:, free]
-            du, info = sla.cg(k_t, residual, M=preconditioner, maxiter=20 * len(free),
-                              **{_CG_TOLERANCE: cg_tolerance})
-            if info != 0:
-                raise SimulationError(f'static solve: conjugate gradients stopped ({info})')
+            if direct_factor is not None:
+                if it > 0 and it % 15 == 0:
+                    direct_factor = _Factor(k_t)
+                du = direct_factor.solve(residual)
+            else:
+                du, info = sla.cg(k_t, residual, M=preconditioner, maxiter=20 * len(free),
+                                  **{_CG_TOLERANCE: cg_tolerance})
+                if info != 0:
+                    raise SimulationError(f'static solve: conjugate gradients stopped ({info})')
             u[free] += du
             if model.interface is None:
                 break

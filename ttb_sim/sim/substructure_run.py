@@ -23,9 +23,19 @@ interface as :class:`~ttb_sim.sim.simulation.Simulation` (layout, dt, steps,
 frames, cost estimate), so the bag writer and the node need not know which
 model they step.
 
+Solver: ``solver.variant`` as :mod:`ttb_sim.sim.variants` maps it.
+``reference`` is the fully implicit Newmark method (every DOF in one
+factorised system; a static load by a direct solve of each Newton iteration),
+the simple validated path, refused before anything is built when its factor
+would not fit in memory (:func:`reference_refusal`). Every other variant runs
+the mixed scheme of :mod:`ttb_sim.sim.pile_soil` (explicit soil and boundary,
+implicit piles, cap and interface; a static load by preconditioned conjugate
+gradients), the pile block factorised by the variant's method.
+
 Time step: ``solver.dt`` (0 = automatic, 1/40 of the load period) is the
-largest step wanted; with the explicit soil of the mixed scheme
-(:mod:`ttb_sim.sim.pile_soil`) the stable step caps it. The step is then
+largest step wanted; the stable step of the explicit soil of the mixed scheme
+caps it, in the ``reference`` too, so that both schemes take the same steps
+and differ only in how the soil is integrated. The step is then
 shortened so that frames (``output.rate_hz``; 0 = one per wanted step) fall
 on steps. A static load gives one frame at t = 0 with the static solution.
 """
@@ -34,20 +44,21 @@ from __future__ import annotations
 
 import logging
 import math
-from typing import Any, Iterator
+from typing import Any, Iterator, Literal
 
 import numpy as np
 
 from ttb_sim.config import Scenario
 from ttb_sim.errors import DivergenceError, ScenarioError
-from ttb_sim.model.foundation.substructure import build, PileSoilModel
+from ttb_sim.model.foundation.substructure import build, PileSoilModel, planned_nodes
 from ttb_sim.sim.cost import CostEstimate, STEP_BUDGET
 from ttb_sim.sim.frames import Frame, Layout
-from ttb_sim.sim.pile_soil import (choose_scheme, initial_state, mixed_stable_step, observe,
+from ttb_sim.sim.pile_soil import (initial_state, mixed_stable_step, observe,
                                    PartitionedNewmark, State, static_solve)
-from ttb_sim.sim.variants import blas_threads
+from ttb_sim.sim.variants import blas_threads, solver_variant, VARIANTS
 
-__all__ = ['SubstructureRun', 'AUTO_STEPS_PER_PERIOD', 'AUTO_PERIODS']
+__all__ = ['SubstructureRun', 'AUTO_STEPS_PER_PERIOD', 'AUTO_PERIODS', 'reference_refusal',
+           'IMPLICIT_MAX_DOFS']
 
 log = logging.getLogger(__name__)
 
@@ -57,8 +68,44 @@ AUTO_PERIODS = 40
 """Load periods of the automatic ``solver.duration`` (2 s at [P]'s 20 Hz)."""
 MICROSECONDS_PER_CELL_STEP = 1.0
 """Estimated cost of one brick for one step (measured 0.63 us of CPU on pile_harmonic)."""
+MICROSECONDS_PER_CELL_STEP_IMPLICIT = 6.0
+"""The same for the fully implicit reference (measured 4.8 us of CPU on single_pile, 47 520
+DOFs, and on a 6 120-DOF coarse mesh: the factor's solve, twice per step with the interface
+iterations)."""
 MESSAGE_MS = 0.08
 """Cost of writing one message to the bag (ms), as :mod:`ttb_sim.sim.cost`."""
+IMPLICIT_MAX_DOFS = 100_000
+"""Most DOFs the fully implicit scheme factorises (an estimated 1 GiB factor)."""
+FACTOR_MIB_PER_DOF43 = 2.3e-4
+"""Memory of the implicit factor per DOF^(4/3) (MiB): the nested-dissection growth of a 3-D
+mesh, fitted to the peak-memory growth measured while factorising coarse single_pile meshes
+(177 MiB at 25 635 DOFs, 272 MiB at 35 916 DOFs: exponent 1.27)."""
+
+
+def implicit_factor_mib(dofs: int) -> float:
+    """Return the estimated memory (MiB) of the fully implicit factor of ``dofs`` DOFs."""
+    return FACTOR_MIB_PER_DOF43 * float(dofs) ** (4.0 / 3.0)
+
+
+def reference_refusal(scenario: Scenario) -> str | None:
+    """
+    Return why the scenario's variant cannot step its substructure, or None if it can.
+
+    Only the fully implicit scheme (``reference``) has a limit: its factor grows as
+    DOFs^(4/3), so above :data:`IMPLICIT_MAX_DOFS` (estimated from the planned mesh,
+    before anything is built) it is refused.
+    """
+    variant = solver_variant(scenario.solver.variant)
+    if not scenario.substructure_only or variant.pile_soil_scheme != 'implicit':
+        return None
+    dofs = 3 * planned_nodes(scenario.substructure('pier01'))
+    if dofs <= IMPLICIT_MAX_DOFS:
+        return None
+    others = ', '.join(repr(n) for n, v in VARIANTS.items() if v.pile_soil_scheme != 'implicit')
+    gib = implicit_factor_mib(dofs) / 1024.0
+    return (f'solver.variant = {variant.name!r}: the fully implicit reference would factorise '
+            f'about {dofs} pile-soil DOFs (factor about {gib:.2g} GiB); allowed up to '
+            f'{IMPLICIT_MAX_DOFS} DOFs: use one of {others}, or coarsen soil.mesh.h')
 
 
 class SubstructureRun:
@@ -83,6 +130,10 @@ class SubstructureRun:
     def __init__(self, scenario: Scenario, max_steps: float | None = STEP_BUDGET) -> None:
         if not scenario.substructure_only:
             raise ScenarioError("load.type = 'none': the scenario is not a substructure run")
+        refusal = reference_refusal(scenario)
+        if refusal is not None:
+            raise ScenarioError(refusal)
+        self.variant = solver_variant(scenario.solver.variant)
         self.scenario = scenario
         self.load = scenario.load
         self.static = self.load.type == 'static'
@@ -106,14 +157,15 @@ class SubstructureRun:
         self.layout = Layout(n_spans=0, n_supports=0, n_bodies=0,
                              piles=((1, model.n_piles),),
                              soil_points=len(model.soil_points.names), train=False)
-        self.scheme = choose_scheme(model, 'auto')
+        self.scheme: Literal['mixed', 'implicit'] = (
+            'implicit' if self.variant.pile_soil_scheme == 'implicit' else 'mixed')
         self.stable_step = math.inf
         self.integrator: PartitionedNewmark | None = None
+        self.factorization = self.variant.pile_soil_factorization or 'cholmod'
         if self.static:
             self.dt, self.n_steps, self.output_every = 0.0, 0, 1
             return
-        if self.scheme == 'mixed':
-            self.stable_step = mixed_stable_step(model)
+        self.stable_step = mixed_stable_step(model)
         # the largest step both wanted and stable, shortened so that frames fall on steps
         largest = min(wanted, self.stable_step)
         rate = scenario.output.rate_hz
@@ -130,7 +182,9 @@ class SubstructureRun:
                 f'stability): solver.duration = {self.duration:.6g} s plans {self.n_steps} '
                 f'steps, over the budget of {max_steps:.3g}; shorten solver.duration or '
                 'coarsen soil.mesh.h, or pass --force')
-        self.integrator = PartitionedNewmark(model, dt, self.scheme)
+        self.integrator = PartitionedNewmark(model, dt, self.scheme,
+                                             factorization=self.variant.pile_soil_factorization)
+        self.factorization = self.integrator.method
         log.info('pile-soil: %s scheme, dt = %.4g s (stable %.4g s), %d steps, %d DOFs',
                  self.scheme, dt, self.stable_step, self.n_steps, model.n_dofs)
 
@@ -147,13 +201,16 @@ class SubstructureRun:
     def describe(self) -> dict[str, Any]:
         """Return the model's sizes and the stepping plan (for ``summary.json``)."""
         return {'pile_soil': dict(self.model.summary), 'scheme': self.scheme,
+                'variant': self.variant.name, 'factorization': self.factorization,
                 'stable_step': None if math.isinf(self.stable_step) else self.stable_step,
                 'load': self.load.type}
 
     def plan(self, messages_per_frame: int) -> CostEstimate:
         """Return the cost estimate of the run (before it runs)."""
         cells = len(self.model.mesh.cells)
-        per_step = MICROSECONDS_PER_CELL_STEP * cells / 1000.0
+        per_brick = (MICROSECONDS_PER_CELL_STEP_IMPLICIT if self.scheme == 'implicit'
+                     else MICROSECONDS_PER_CELL_STEP)
+        per_step = per_brick * cells / 1000.0
         messages = self.n_frames * messages_per_frame
         wall = 0.3 + (self.n_steps * per_step + messages * MESSAGE_MS) / 1000.0
         if self.static:
@@ -177,7 +234,9 @@ class SubstructureRun:
         # (measured: static single_pile 3x faster with one thread on a loaded machine).
         with blas_threads(1):
             if self.static:
-                yield self._frame(0, static_solve(self.model, self.force))
+                yield self._frame(0, static_solve(
+                    self.model, self.force, direct=self.scheme == 'implicit',
+                    factorization=self.variant.pile_soil_factorization))
                 return
             assert self.integrator is not None
             state = initial_state(self.model)

@@ -23,6 +23,13 @@ its bags stay bit-identical to those of earlier versions on the same machine.
 ``reduced`` is the one variant that changes the model, not only how it is
 solved: the track away from the train rides on the girder (an approximation
 with a stated range, README Benchmark); it is opt-in.
+A pile-soil substructure on its own (``scenario.substructure_only``,
+:mod:`ttb_sim.sim.substructure_run`) reads the same table: ``reference`` steps
+it fully implicit (one factorisation of every DOF, the validated Newmark
+method; a static load by a direct solve of each Newton iteration) and every
+other variant in the mixed scheme (explicit soil, implicit piles, cap and
+interface; a static load by preconditioned conjugate gradients), the pile block
+factorised by the variant's method.
 The other variants run the BLAS single-threaded: the small dense solves of the
 contact iteration (32 x 32 per car) only spin a second thread (measured 9x
 slower with two threads on two cores), and one thread makes the results
@@ -53,14 +60,25 @@ class SolverVariant:
     reduced: bool = False
     """True to solve the slab track in detail only in a window around the train
     (:mod:`ttb_sim.sim.reduced_track`); models without a slab track run as without."""
+    pile_soil_scheme: str = 'mixed'
+    """Scheme of a pile-soil substructure run (:mod:`ttb_sim.sim.pile_soil`): 'implicit'
+    or 'mixed'."""
+    pile_soil_factorization: str | None = None
+    """Method of :func:`ttb_sim.fe.factorization.factorize` for the pile-soil matrices;
+    None = the pile-soil module's own (CHOLMOD through cholespy, else SuperLU)."""
 
 
 VARIANTS = {
-    'reference': SolverVariant('reference', 'superlu', lean=False, blas_threads=None),
-    'cholmod': SolverVariant('cholmod', 'cholmod', lean=True, blas_threads=1),
-    'qdldl': SolverVariant('qdldl', 'qdldl', lean=True, blas_threads=1),
-    'superlu_sym': SolverVariant('superlu_sym', 'superlu_sym', lean=True, blas_threads=1),
-    'reduced': SolverVariant('reduced', 'qdldl', lean=True, blas_threads=1, reduced=True),
+    'reference': SolverVariant('reference', 'superlu', lean=False, blas_threads=None,
+                               pile_soil_scheme='implicit'),
+    'cholmod': SolverVariant('cholmod', 'cholmod', lean=True, blas_threads=1,
+                             pile_soil_factorization='cholmod'),
+    'qdldl': SolverVariant('qdldl', 'qdldl', lean=True, blas_threads=1,
+                           pile_soil_factorization='qdldl'),
+    'superlu_sym': SolverVariant('superlu_sym', 'superlu_sym', lean=True, blas_threads=1,
+                                 pile_soil_factorization='superlu_sym'),
+    'reduced': SolverVariant('reduced', 'qdldl', lean=True, blas_threads=1, reduced=True,
+                             pile_soil_factorization='qdldl'),
 }
 """Every variant by name (the choices of ``solver.variant``)."""
 
