@@ -22,6 +22,8 @@ spring-founded bridge to round-off, the partitioned one with n = 1 to the
 staggering error and with n = 3 to the first-order extrapolation error.
 """
 
+import logging
+
 import numpy as np
 import pytest
 
@@ -140,3 +142,15 @@ def test_partitioned_scheme_decays_after_the_train_has_left(spring_piles):
 def test_piled_scenario_errors_name_the_key(override, message):
     with pytest.raises(ScenarioError, match=message):
         load_scenario('ten_span_train', BRIDGE + PILED + override)
+
+
+def test_loading_above_the_soil_mesh_resolution_is_warned(caplog):
+    """The first car line V / 25 m (3.33 Hz at 300 km/h) against the mesh's f_max."""
+    scenario = load_scenario('paper_ttbcpsi')
+    with caplog.at_level(logging.WARNING, logger='ttb_sim.sim.build'):
+        assert build.warn_unresolved_loading(scenario, 1.30)
+    assert 'soil.mesh.h_max = 3 m' in caplog.text and '3.33 Hz' in caplog.text
+    caplog.clear()
+    with caplog.at_level(logging.WARNING, logger='ttb_sim.sim.build'):
+        assert not build.warn_unresolved_loading(scenario, 3.34)
+    assert caplog.text == ''

@@ -23,6 +23,7 @@ out of the scenario once and hands each model builder what it needs.
 from __future__ import annotations
 
 from dataclasses import dataclass
+import logging
 
 import numpy as np
 
@@ -40,6 +41,8 @@ from ttb_sim.sim.coupling.quarter_car import QuarterCarTrain
 from ttb_sim.sim.coupling.train_track import TrainTrackCoupling
 from ttb_sim.sim.integrators.protocol import Integrator
 from ttb_sim.sim.reduced_track import ReducedTrainTrackCoupling
+
+LOG = logging.getLogger(__name__)
 
 __all__ = ['build_coupling', 'build_irregularity', 'build_structure', 'build_vehicle',
            'CONTACT_STEP', 'observer_rows', 'StepLimits', 'vehicle_track_setup',
@@ -79,10 +82,32 @@ def build_foundation(scenario: Scenario) -> FoundationOperator:
 
     b, pr = scenario.bridge, scenario.piers
     f1 = span_frequency(b.span_length, b.bending_stiffness, b.mass_per_length)
-    return pile_soil_operator(scenario.substructure(), pr.height, pr.elements,
-                              pier_section(pr),
-                              rayleigh_coefficients(b.damping_ratio, f1, 4 * f1),
-                              scenario.soil.reduction)
+    operator = pile_soil_operator(scenario.substructure(), pr.height, pr.elements,
+                                  pier_section(pr),
+                                  rayleigh_coefficients(b.damping_ratio, f1, 4 * f1),
+                                  scenario.soil.reduction)
+    warn_unresolved_loading(scenario, float(operator.summary.get('f_max', np.inf)))
+    return operator
+
+
+def warn_unresolved_loading(scenario: Scenario, f_max: float) -> bool:
+    """
+    Warn when the train loads the piled piers above what the soil mesh carries.
+
+    The first car-passage line V / car length is always in the pier load; above
+    the mesh's f_max (Vs_min / (8 h) in its coarsest cells) the pile and soil
+    streams are the truncated, coarse block's resonances rather than waves in the
+    ground. Returns whether it warned.
+    """
+    line = scenario.train.speed / scenario.train.car_length
+    if f_max >= line:
+        return False
+    LOG.warning('the soil mesh carries waves up to %.2f Hz in its coarsest cells '
+                '(soil.mesh.h_max = %g m), below the first car-passage frequency %.2f Hz: '
+                'the pile and soil streams above %.2f Hz show the coarse block, not the ground '
+                '(docs/coupled.md, "The reduced substructure")', f_max,
+                scenario.soil.mesh.h_max, line, f_max)
+    return True
 
 
 def build_vehicle(scenario: Scenario) -> Vehicle:
