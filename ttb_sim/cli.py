@@ -84,6 +84,16 @@ def _parser() -> argparse.ArgumentParser:
     be.add_argument('--set', dest='overrides', action='append', default=[],
                     metavar='KEY=VALUE', help='override a scenario key; repeatable')
 
+    mo = sub.add_parser('modes', help="natural modes of a scenario's bridge, track and piled "
+                        'piers nearest a frequency')
+    mo.add_argument('scenario', help='YAML path or built-in name')
+    mo.add_argument('--around', type=float, default=5.0, metavar='HZ',
+                    help='centre frequency (default 5 Hz)')
+    mo.add_argument('--count', type=int, default=20, help='number of modes (default 20)')
+    mo.add_argument('--set', dest='overrides', action='append', default=[],
+                    metavar='KEY=VALUE', help='override a scenario key; repeatable')
+    mo.add_argument('--json', type=Path, metavar='FILE', help='also write the modes as JSON')
+
     an = sub.add_parser('analyze', help='figures, metrics.json and index.html from a bag')
     an.add_argument('bag', help='bag directory (metadata.yaml + .mcap/.db3) or storage file')
     an.add_argument('--out', type=Path, help='output folder (default: BAG/analysis)')
@@ -200,6 +210,10 @@ def _main(argv: Sequence[str] | None) -> int:
                                  duration=args.duration, json_path=args.json,
                                  repeat=args.repeat, isolate=not args.in_process,
                                  overrides=args.overrides)
+        if args.command == 'modes':
+            from ttb_sim.commands.modes import modes_command
+            return modes_command(args.scenario, around=args.around, count=args.count,
+                                 overrides=args.overrides, json_path=args.json)
         from ttb_sim.commands.scenarios import scenarios
         return scenarios(keys=args.keys)
     except (ScenarioError, ModelError) as exc:
