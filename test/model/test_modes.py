@@ -94,6 +94,11 @@ def test_modes_command_refuses_bad_input(tmp_path, capsys, args, match):
     assert not out.exists()
 
 
+def test_modes_command_refuses_a_substructure_only_scenario(capsys):
+    assert main(['modes', 'single_pile']) == 2
+    assert "load.type = 'static'" in capsys.readouterr().err
+
+
 def test_modes_command_refuses_a_json_path_in_a_missing_folder(tmp_path, capsys):
     assert main(['modes', 'ten_span_train', '--json', str(tmp_path / 'no' / 'm.json')]) == 2
     assert '--json' in capsys.readouterr().err

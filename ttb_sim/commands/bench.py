@@ -430,7 +430,6 @@ def bench(scenarios: Sequence[str] = (), variants: Sequence[str] = (),
         workload is checked before the first run).
 
     """
-    check_variants(variants or variant_names())
     if repeat < 1:
         raise ScenarioError(f'--repeat = {repeat}: must be at least 1')
     named = scenarios or tuple(DEFAULT_WORKLOADS)
@@ -438,23 +437,21 @@ def bench(scenarios: Sequence[str] = (), variants: Sequence[str] = (),
     run = measure_isolated if isolate else measure
     runs: list[dict[str, Any]] = []
     for plan in plans:
-        scenario, names, span, sets, refusal = (plan.scenario, plan.variants, plan.duration,
-                                                plan.overrides, plan.refusal)
         best: dict[str, tuple[dict[str, Any], Traces]] = {}
         for _round in range(repeat):
-            for name in names:
-                if name == REFERENCE and refusal is not None:
+            for name in plan.variants:
+                if name == REFERENCE and plan.refusal is not None:
                     continue
                 if progress is not None:
-                    progress(f'{scenario} / {name}')
-                metrics, traces = run(scenario, name, span, sets)
+                    progress(f'{plan.scenario} / {name}')
+                metrics, traces = run(plan.scenario, name, plan.duration, plan.overrides)
                 kept = best.get(name)
                 if kept is None or _faster(metrics, kept[0]):
                     best[name] = (metrics, traces if kept is None else kept[1])
         reference = best[REFERENCE][1] if REFERENCE in best else {}
-        for name in names:
+        for name in plan.variants:
             if name not in best:
-                runs.append(_refused(plan.name, name, refusal or ''))
+                runs.append(_refused(plan.name, name, plan.refusal or ''))
                 continue
             metrics, traces = best[name]
             metrics['difference'] = compare(traces, reference)

@@ -72,6 +72,10 @@ def modes_report(scenario: str | Path, *, around: float = 5.0, count: int = 20,
     from ttb_sim.config import load_scenario
 
     loaded = load_scenario(scenario, overrides)
+    if loaded.substructure_only:
+        raise ScenarioError(f'load.type = {loaded.load.type!r}: {loaded.name} is a pile-soil '
+                            "substructure run without a bridge; allowed: load.type = 'none' "
+                            '(a scenario with a bridge)')
     if loaded.foundation.model == 'piled':
         loaded = load_scenario(scenario, [*overrides, 'solver.coupling=monolithic',
                                           'solver.substructure_steps=1'])

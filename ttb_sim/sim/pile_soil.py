@@ -66,7 +66,7 @@ import scipy.sparse.linalg as sla
 
 from ttb_sim.errors import DivergenceError, SimulationError
 from ttb_sim.fe import hex8
-from ttb_sim.fe.factorization import Factorization, factorize
+from ttb_sim.fe.factorization import factorize
 from ttb_sim.model.foundation.substructure import PileSoilModel, rayleigh_coefficients
 
 LOG = logging.getLogger(__name__)
@@ -121,47 +121,6 @@ def observe(model: PileSoilModel, state: State) -> PileSoilFrame:
                          (hd @ state.a).reshape(n_p, 3), (hr @ state.u).reshape(n_p, 3),
                          (hr @ state.v).reshape(n_p, 3), (sp_op @ state.u).reshape(n_s, 3),
                          (sp_op @ state.a).reshape(n_s, 3))
-
-
-class _Factor:
-    """
-    A once-factorised symmetric positive definite matrix.
-
-    ``method`` None is this module's own choice (CHOLMOD via cholespy, else
-    SuperLU with minimum degree on A^T + A); otherwise a method of
-    :func:`ttb_sim.fe.factorization.factorize` (a solver variant's).
-    """
-
-    def __init__(self, matrix: sp.spmatrix, method: Optional[str] = None) -> None:
-        a = sp.csr_matrix(matrix)
-        self.n = a.shape[0]
-        self._chol = None
-        self._lu = None
-        self._other: Optional[Factorization] = None
-        if method is not None:
-            self._other = factorize(a, method=method)
-            self.method = self._other.method
-            return
-        try:
-            from cholespy import CholeskySolverD, MatrixType
-            a.sort_indices()
-            self._chol = CholeskySolverD(self.n, a.indptr.astype(np.int32),
-                                         a.indices.astype(np.int32), a.data.astype(float),
-                                         MatrixType.CSR)
-            self.method = 'cholmod'
-        except ImportError:  # pragma: no cover - cholespy is optional
-            self._lu = sla.splu(a.tocsc(), permc_spec='MMD_AT_PLUS_A')
-            self.method = 'superlu'
-
-    def solve(self, b: np.ndarray) -> np.ndarray:
-        if self._other is not None:
-            return self._other.solve(np.ascontiguousarray(b, dtype=float))
-        if self._chol is not None:
-            x = np.zeros_like(b, dtype=float)
-            self._chol.solve(np.ascontiguousarray(b, dtype=float), x)
-            return x
-        assert self._lu is not None
-        return self._lu.solve(b)
 
 
 def _interface_response(model: PileSoilModel, u: np.ndarray, slip: Optional[np.ndarray]
@@ -260,9 +219,9 @@ class PartitionedNewmark:
         Relative residual at which the Newton iterations stop.
     max_iterations : int
         Iterations per step before a :class:`~ttb_sim.errors.SimulationError`.
-    factorization : str, optional
+    factorization : str
         Method of :func:`ttb_sim.fe.factorization.factorize` for the implicit
-        block; None = CHOLMOD via cholespy, else SuperLU.
+        block (symmetric positive definite; CHOLMOD by default).
 
     """
 
@@ -270,7 +229,7 @@ class PartitionedNewmark:
                  scheme: Literal['mixed', 'implicit'] = 'mixed',
                  newton: Literal['modified', 'full'] = 'modified',
                  tolerance: float = 1e-6, max_iterations: int = 100,
-                 factorization: Optional[str] = None) -> None:
+                 factorization: str = 'cholmod') -> None:
         self.model = model
         self.factorization = factorization
         self.dt = float(dt)
@@ -319,9 +278,7 @@ class PartitionedNewmark:
         self.m_e = model.mass[self.explicit]
         k0 = model.initial_interface_stiffness()[idx][:, idx]
         self._k_ifc0 = k0
-        self._factor = _Factor(self._matrix(k0), factorization)
-        self.method = self._factor.method
-        """Factorisation method actually used."""
+        self._factor = factorize(self._matrix(k0), method=factorization)
         self.iterations = 0
 
     def _matrix(self, k_ifc: sp.spmatrix) -> sp.csr_matrix:
@@ -368,7 +325,7 @@ class PartitionedNewmark:
                 if refresh and tangent is not None:
                     assert model.interface is not None
                     k_t = model.interface.stiffness(tangent)[idx][:, idx]
-                    factor = _Factor(self._matrix(k_t), self.factorization)
+                    factor = factorize(self._matrix(k_t), method=self.factorization)
             a_i = a_i + factor.solve(residual)
             self.iterations += 1
             if not nonlinear:
@@ -407,7 +364,7 @@ def implicit_dofs(model: PileSoilModel) -> np.ndarray:
 def static_solve(model: PileSoilModel, force: np.ndarray, increments: int = 5,
                  tolerance: float = 1e-6, max_iterations: int = 50,
                  cg_tolerance: float = 1e-10, direct: bool = False,
-                 factorization: Optional[str] = None) -> State:
+                 factorization: str = 'cholmod') -> State:
     """
     Return the static state under ``force`` (N), applied in equal increments.
 
@@ -439,7 +396,7 @@ def static_solve(model: PileSoilModel, force: np.ndarray, increments: int = 5,
     k0 = (k_lin + model.initial_interface_stiffness()).tocsr()[free][:, free]
     block = np.flatnonzero(implicit_dofs(model)[free])
     diagonal = k0.diagonal()
-    block_factor = (_Factor(k0[block][:, block], factorization)
+    block_factor = (factorize(k0[block][:, block], method=factorization)
                     if len(block) and not direct else None)
 
     def precondition(r: np.ndarray) -> np.ndarray:
@@ -455,7 +412,7 @@ def static_solve(model: PileSoilModel, force: np.ndarray, increments: int = 5,
     scale = max(float(np.linalg.norm(force)), 1e-30)
     # direct: modified Newton on the initial tangent, refactorised at the current tangent
     # when an increment needs more than 15 iterations (as PartitionedNewmark)
-    direct_factor = _Factor(k0) if direct else None
+    direct_factor = factorize(k0, method=factorization) if direct else None
     for step in range(1, increments + 1):
         target = force * step / increments
         for it in range(max_iterations):
@@ -469,7 +426,7 @@ def static_solve(model: PileSoilModel, force: np.ndarray, increments: int = 5,
                 k_t = k_lin_free + model.interface.stiffness(tangent)[free][:, free]
             if direct_factor is not None:
                 if it > 0 and it % 15 == 0:
-                    direct_factor = _Factor(k_t)
+                    direct_factor = factorize(k_t, method=factorization)
                 du = direct_factor.solve(residual)
             else:
                 du, info = sla.cg(k_t, residual, M=preconditioner, maxiter=20 * len(free),

@@ -50,6 +50,7 @@ import numpy as np
 
 from ttb_sim.config import Scenario
 from ttb_sim.errors import DivergenceError, ScenarioError
+from ttb_sim.fe.factorization import resolve
 from ttb_sim.model.foundation.substructure import build, PileSoilModel, planned_nodes
 from ttb_sim.sim.cost import CostEstimate, STEP_BUDGET
 from ttb_sim.sim.frames import Frame, Layout
@@ -161,7 +162,8 @@ class SubstructureRun:
             'implicit' if self.variant.pile_soil_scheme == 'implicit' else 'mixed')
         self.stable_step = math.inf
         self.integrator: PartitionedNewmark | None = None
-        self.factorization = self.variant.pile_soil_factorization or 'cholmod'
+        self.factorization = resolve(self.variant.pile_soil_factorization)
+        """Factorisation method in use (after any fallback)."""
         if self.static:
             self.dt, self.n_steps, self.output_every = 0.0, 0, 1
             return
@@ -183,8 +185,7 @@ class SubstructureRun:
                 f'steps, over the budget of {max_steps:.3g}; shorten solver.duration or '
                 'coarsen soil.mesh.h, or pass --force')
         self.integrator = PartitionedNewmark(model, dt, self.scheme,
-                                             factorization=self.variant.pile_soil_factorization)
-        self.factorization = self.integrator.method
+                                             factorization=self.factorization)
         log.info('pile-soil: %s scheme, dt = %.4g s (stable %.4g s), %d steps, %d DOFs',
                  self.scheme, dt, self.stable_step, self.n_steps, model.n_dofs)
 
@@ -236,7 +237,7 @@ class SubstructureRun:
             if self.static:
                 yield self._frame(0, static_solve(
                     self.model, self.force, direct=self.scheme == 'implicit',
-                    factorization=self.variant.pile_soil_factorization))
+                    factorization=self.factorization))
                 return
             assert self.integrator is not None
             state = initial_state(self.model)

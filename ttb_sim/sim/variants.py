@@ -63,22 +63,25 @@ class SolverVariant:
     pile_soil_scheme: str = 'mixed'
     """Scheme of a pile-soil substructure run (:mod:`ttb_sim.sim.pile_soil`): 'implicit'
     or 'mixed'."""
-    pile_soil_factorization: str | None = None
-    """Method of :func:`ttb_sim.fe.factorization.factorize` for the pile-soil matrices;
-    None = the pile-soil module's own (CHOLMOD through cholespy, else SuperLU)."""
+
+    @property
+    def pile_soil_factorization(self) -> str:
+        """
+        Method of :func:`ttb_sim.fe.factorization.factorize` for the pile-soil matrices.
+
+        The variant's own symmetric method; the reference's general SuperLU would only
+        add fill to these symmetric positive definite 3-D matrices, so it takes CHOLMOD.
+        """
+        return 'cholmod' if self.factorization == 'superlu' else self.factorization
 
 
 VARIANTS = {
     'reference': SolverVariant('reference', 'superlu', lean=False, blas_threads=None,
                                pile_soil_scheme='implicit'),
-    'cholmod': SolverVariant('cholmod', 'cholmod', lean=True, blas_threads=1,
-                             pile_soil_factorization='cholmod'),
-    'qdldl': SolverVariant('qdldl', 'qdldl', lean=True, blas_threads=1,
-                           pile_soil_factorization='qdldl'),
-    'superlu_sym': SolverVariant('superlu_sym', 'superlu_sym', lean=True, blas_threads=1,
-                                 pile_soil_factorization='superlu_sym'),
-    'reduced': SolverVariant('reduced', 'qdldl', lean=True, blas_threads=1, reduced=True,
-                             pile_soil_factorization='qdldl'),
+    'cholmod': SolverVariant('cholmod', 'cholmod', lean=True, blas_threads=1),
+    'qdldl': SolverVariant('qdldl', 'qdldl', lean=True, blas_threads=1),
+    'superlu_sym': SolverVariant('superlu_sym', 'superlu_sym', lean=True, blas_threads=1),
+    'reduced': SolverVariant('reduced', 'qdldl', lean=True, blas_threads=1, reduced=True),
 }
 """Every variant by name (the choices of ``solver.variant``)."""
 
