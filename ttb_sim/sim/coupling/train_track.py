@@ -217,6 +217,39 @@ class RailCompliance:
             if influence_hops is not None:
                 self.influence.append(columns.arrays())
 
+    def restricted(self, free_to_kept: np.ndarray, n_kept: int) -> RailCompliance:
+        """
+        Return this compliance on a subset of the free DOFs (a reduced model's).
+
+        The element blocks stay as they are (they are indexed by rail element);
+        each node's K^-1 columns keep their entries on kept DOFs, renumbered.
+        Used where the kept DOFs solve the same model near the rails (the
+        reduced track's window): the columns then differ only by what the
+        condensed DOFs far away change, and the single-solve step's check
+        corrects the rest.
+
+        Parameters
+        ----------
+        free_to_kept : numpy.ndarray
+            (n_free + 1,) the new index of each free DOF (and of the ground slot);
+            ``n_kept`` where the DOF is not kept.
+        n_kept : int
+            Number of kept DOFs.
+
+        """
+        out = RailCompliance.__new__(RailCompliance)
+        out.blocks = self.blocks
+        out.influence = []
+        for start, dofs, values in self.influence:
+            new = free_to_kept[dofs]
+            keep = new < n_kept
+            node = np.repeat(np.arange(start.size - 1), np.diff(start))[keep]
+            counts = np.bincount(node, minlength=start.size - 1)
+            out.influence.append((np.concatenate([[0], np.cumsum(counts)]).astype(np.intp),
+                                  new[keep].astype(np.intp),
+                                  np.ascontiguousarray(values[keep])))
+        return out
+
 
 class _Columns:
     """Each rail node's K^-1 columns on its neighbourhood, the small entries dropped."""
