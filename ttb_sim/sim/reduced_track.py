@@ -17,27 +17,28 @@ The reduced track-bridge (``solver.variant: reduced``): detail only in a window 
 
 Only the track near the train is solved in detail: rails, fasteners, slabs and
 base plates whose nodes lie within ``[rear axle - BACK_MARGIN, front axle +
-FRONT_MARGIN + ADVANCE]``. The girders, bearings and piers are kept whole.
-Every other track DOF follows the bridge:
+FRONT_MARGIN + ADVANCE]``, widened to the nearest slab-unit joints. The girders,
+bearings and piers are kept whole, and so are the rail nodes over every joint
+between slab units (the rail cuts). Every other track DOF follows them:
 
-* stiffness and state: u_far = T_t u_bridge, the static response of the
-  unloaded track to the bridge's displacement (T_t = -K_tt^-1 K_tb, computed
-  once; Guyan condensation). The reduced stiffness T^T K T therefore gives the
-  bridge exactly the static stiffness the full model has, including the
-  track's continuity over the span joints through its compliant layers.
-  Entries of T_t below BASIS_DROP of their column's largest are dropped.
+* stiffness and state: u_far = T_t u_master, the static response of the
+  unloaded track to the motion of the bridge and of the rail cuts (T_t =
+  -K_tt^-1 K_tm, computed once; Guyan condensation). The slab units touch
+  each other only through the rails, so with the rails cut over the joints
+  every unit is condensed on its own: T_t is local (a unit's nodes follow the
+  girder below it and the two cuts at its ends) and so is the reduced
+  stiffness T^T K T, which gives the bridge exactly the static stiffness of
+  the full model, the track's continuity over the span joints included.
 * mass and damping: the far track rides rigidly on the girder axis below it
-  (local; the rotation about x carries the offsets), so the reduced M and C
-  stay as sparse as the full model's and the history mat-vec shrinks with the
-  DOFs. The far track's layers and fasteners do not deform in this motion and
-  add no damping.
+  (local; the rotation about x carries the offsets), the cuts move as
+  themselves. The far track's layers and fasteners do not deform in this
+  motion and add no damping.
 
-When the front axle comes within FRONT_MARGIN of the window's end the window
-is rebuilt ahead (about every ADVANCE metres of travel, a second or two of
-set-up each): the state is expanded to all DOFs with the old T and restricted
-to the new window's DOFs. Track that enters the window starts where the
-unloaded track would be; track that leaves it behind the train loses its
-vibration relative to the girder.
+When the front axle comes within FRONT_MARGIN of the window's end the window is
+rebuilt ahead (about every ADVANCE metres of travel): the state is expanded to
+all DOFs with the old T and restricted to the new window's DOFs. Track that
+enters the window starts where the unloaded track would be; track that leaves
+it behind the train loses its vibration relative to the girder.
 
 Range of validity: the wheel-rail forces see the full track within the
 window. The bridge sees the far track through its static stiffness and as
@@ -75,11 +76,9 @@ FRONT_MARGIN = 30.0
 """Detailed track kept ahead of the first axle (m): the window moves before it is less."""
 ADVANCE = 40.0
 """Extra detailed track ahead, so the window moves about every ADVANCE metres of travel."""
-BASIS_DROP = 1e-5
+BASIS_DROP = 1e-12
 """Entries of the static track basis below this fraction of their column's largest are
-dropped. Measured on paper_ttbi: 1e-5 keeps the lowest twelve modes within 0.04 %; 1e-4
-moved them by up to 0.3 %, and 1e-3 (measured with this basis for the mass too) by up to
-10 %, for a sparser reduced stiffness."""
+dropped (round-off: the basis of a slab unit is dense over the unit)."""
 BASIS_CHUNK = 64
 """Bridge DOFs per batch of the static solves that build the basis."""
 
@@ -143,40 +142,92 @@ def track_free_dofs(structure: Structure) -> tuple[np.ndarray, np.ndarray]:
     return structure.full_to_free[full], np.concatenate(xs)[index]
 
 
-def static_track_basis(structure: Structure, method: str) -> sp.csr_matrix:
+@dataclass(frozen=True)
+class StaticTrackBasis:
     """
-    Return the static response of the unloaded track to the bridge's motion.
+    The static response of the unloaded track to its masters (:func:`static_track_basis`).
 
-    T_t = -K_tt^-1 K_tb, (n_free, n_free) with non-zero rows only at the track
-    DOFs and non-zero columns only at the bridge DOFs (girders, bearings, piers)
-    that the track rests on: where the track would be, with no load on it, for
-    a given bridge displacement. Vertically it decays within metres of each
-    girder node, longitudinally (the continuous rails) over tens of metres;
-    entries below ``BASIS_DROP`` of the largest in their column are dropped.
+    Attributes
+    ----------
+    basis : scipy.sparse.csr_matrix
+        T_t, (n_free, n_free): non-zero rows at the condensed track DOFs, non-zero
+        columns at the masters they rest on.
+    cuts : numpy.ndarray
+        Free DOFs of the rail nodes over the slab-unit joints (masters, kept in
+        every window).
+    joints : numpy.ndarray
+        Positions of the joints between slab units (m along the track, increasing).
+
+    """
+
+    basis: sp.csr_matrix
+    cuts: np.ndarray
+    joints: np.ndarray
+
+
+def slab_joints(structure: Structure) -> np.ndarray:
+    """Return the positions of the gaps between slab units (m, increasing)."""
+    track = structure.track
+    if track is None:
+        raise ValueError('the reduced track needs a structure with a track')
+    slab = track.slab
+    end = slab.start[:-1] + slab.length[:-1]
+    gap = np.flatnonzero(slab.start[1:] - end > 1e-9 * slab.length.max())
+    return 0.5 * (end[gap] + slab.start[1:][gap])
+
+
+def rail_cuts(structure: Structure, joints: np.ndarray) -> np.ndarray:
+    """Return the free DOFs of each rail's node nearest to every joint (sorted)."""
+    track = structure.track
+    assert track is not None
+    cuts = []
+    for rail in track.rails:
+        x = np.append(rail.start, rail.start[-1] + rail.length[-1])
+        nodes = np.vstack([rail.dofs[:, :6], rail.dofs[-1:, 6:]])
+        nearest = np.abs(x[None, :] - joints[:, None]).argmin(axis=1)
+        cuts.append(structure.full_to_free[nodes[nearest]].ravel())
+    cut = np.unique(np.concatenate(cuts)) if cuts else np.zeros(0, dtype=np.intp)
+    return cut[cut < structure.n_free]
+
+
+def static_track_basis(structure: Structure, method: str) -> StaticTrackBasis:
+    """
+    Return the static response of the unloaded track to the bridge and the rail cuts.
+
+    T_t = -K_tt^-1 K_tm over the track DOFs t other than the rail cuts, the
+    masters m being the bridge DOFs (girders, bearings, piers) and the rail
+    nodes over the slab-unit joints: where the track would be, with no load on
+    it, for a given motion of the masters. The slab units touch each other only
+    through the rails, so each unit responds only to the girder below it and
+    the cuts at its two ends. Entries below ``BASIS_DROP`` of the largest in
+    their column are dropped. A track without joints is condensed whole.
     """
     n_free = structure.n_free
     track_free, _ = track_free_dofs(structure)
-    track = np.unique(track_free[track_free < n_free])
+    joints = slab_joints(structure)
+    cuts = rail_cuts(structure, joints)
+    track = np.setdiff1d(track_free[track_free < n_free], cuts)
     is_track = np.zeros(n_free, dtype=bool)
     is_track[track] = True
-    bridge = np.flatnonzero(~is_track)
+    masters = np.flatnonzero(~is_track)
     k = structure.stiffness.tocsr()
     k_tt = k[track][:, track].tocsc()
-    k_tb = k[track][:, bridge].tocsc()
-    touched = np.flatnonzero(np.diff(k_tb.indptr))     # bridge DOFs the track rests on
+    k_tm = k[track][:, masters].tocsc()
+    touched = np.flatnonzero(np.diff(k_tm.indptr))     # masters the track rests on
     if touched.size == 0:
-        return sp.csr_matrix((n_free, n_free))
+        return StaticTrackBasis(sp.csr_matrix((n_free, n_free)), cuts, joints)
     lu = factorize(k_tt, method=method)
     rows, cols, vals = [], [], []
     for chunk in np.array_split(touched, max(1, touched.size // BASIS_CHUNK)):
-        x = -lu.solve(k_tb[:, chunk].toarray())
+        x = -lu.solve(k_tm[:, chunk].toarray())
         peak = np.max(np.abs(x), axis=0)
         r, c = np.nonzero(np.abs(x) > BASIS_DROP * peak)
         rows.append(track[r])
-        cols.append(bridge[chunk[c]])
+        cols.append(masters[chunk[c]])
         vals.append(x[r, c])
-    return sp.csr_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
-                         shape=(n_free, n_free))
+    basis = sp.csr_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
+                          shape=(n_free, n_free))
+    return StaticTrackBasis(basis, cuts, joints)
 
 
 def rigid_track_basis(structure: Structure) -> sp.csr_matrix:
@@ -213,21 +264,30 @@ def rigid_track_basis(structure: Structure) -> sp.csr_matrix:
     return sp.csr_matrix((node_rows[ok], (rows[ok], cols[ok])), shape=(n_free, n_free))
 
 
-def track_window(structure: Structure, static: sp.csr_matrix, rigid: sp.csr_matrix,
+def track_window(structure: Structure, static: StaticTrackBasis, rigid: sp.csr_matrix,
                  start: float, end: float) -> TrackWindow:
     """
     Build the reduction basis with the track detailed between ``start`` and ``end``.
+
+    The ends move out to the nearest slab-unit joints, so that every far unit
+    is condensed whole (its statics exact).
 
     Parameters
     ----------
     structure : Structure
         The assembled track and bridge.
-    static, rigid : scipy.sparse.csr_matrix
-        :func:`static_track_basis` and :func:`rigid_track_basis` of the structure.
+    static : StaticTrackBasis
+        :func:`static_track_basis` of the structure.
+    rigid : scipy.sparse.csr_matrix
+        :func:`rigid_track_basis` of the structure.
     start, end : float
-        Ends of the detailed track (m along the track).
+        Ends of the detailed track before widening (m along the track).
 
     """
+    joints = static.joints
+    before, after = joints[joints <= start], joints[joints >= end]
+    start = float(before[-1]) if before.size else start
+    end = float(after[0]) if after.size else end
     n_free = structure.n_free
     track_free, x = track_free_dofs(structure)
     valid = track_free < n_free
@@ -236,15 +296,14 @@ def track_window(structure: Structure, static: sp.csr_matrix, rigid: sp.csr_matr
     inside = (x >= start) & (x <= end)
     keep = ~is_track
     keep[track_free[inside][valid[inside]]] = True
+    keep[static.cuts] = True
     kept = np.flatnonzero(keep)
     n_red = kept.size
     free_to_red = np.full(n_free + 1, n_red)
     free_to_red[kept] = np.arange(n_red)
-    # Kept DOFs: identity rows; far track: the static response to the bridge DOFs
-    # (every bridge DOF is kept).
-    far = np.zeros(n_free, dtype=bool)
-    far[track_free[~inside][valid[~inside]]] = True
-    select = sp.diags(far.astype(float))
+    # Kept DOFs: identity rows; far track: its response to the masters (the bridge DOFs
+    # and the rail cuts, all kept).
+    select = sp.diags((~keep).astype(float))
 
     def basis(far_motion: sp.csr_matrix) -> sp.csr_matrix:
         coo = (select @ far_motion).tocoo()
@@ -254,7 +313,7 @@ def track_window(structure: Structure, static: sp.csr_matrix, rigid: sp.csr_matr
                              shape=(n_free, n_red))
 
     full_to_red = free_to_red[structure.full_to_free]
-    return TrackWindow(start, end, basis(static), basis(rigid), kept, full_to_red)
+    return TrackWindow(start, end, basis(static.basis), basis(rigid), kept, full_to_red)
 
 
 def project(matrix: sp.spmatrix, basis: sp.csr_matrix) -> sp.csr_matrix:
@@ -286,7 +345,7 @@ class ReducedTrainTrackCoupling(TrainTrackCoupling):
         self._dt = float(integrator.dt)
         self._method = str(integrator.method)
         self.window: TrackWindow | None = None
-        self._bases: tuple[sp.csr_matrix, sp.csr_matrix] | None = None
+        self._bases: tuple[StaticTrackBasis, sp.csr_matrix] | None = None
         self.window_moves = 0
         """How many times the window was built (the first included)."""
         self.window_time = 0.0
