@@ -289,9 +289,11 @@ def _check_piled(s: Scenario) -> None:
     if solver.coupling == 'monolithic' and solver.substructure_steps != 1:
         raise ScenarioError(f"solver.coupling = 'monolithic' needs solver.substructure_steps = "
                             f'1 (got {solver.substructure_steps}): one system has one step')
-    if solver.variant == 'reduced':
-        raise ScenarioError("solver.variant = 'reduced' does not support foundation.model = "
-                            "'piled'; allowed: qdldl, cholmod, superlu_sym, reference")
+    if solver.variant == 'reduced' and solver.coupling == 'monolithic':
+        raise ScenarioError("solver.variant = 'reduced' does not support solver.coupling = "
+                            "'monolithic' (the piled piers inside the track-bridge system); "
+                            "allowed: 'partitioned', or solver.variant qdldl, cholmod, "
+                            'superlu_sym, reference')
     _check_substructure(s)
 
 

@@ -60,6 +60,7 @@ is the unconditionally stable reference.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Callable
 
 import numpy as np
 import scipy.linalg as sla
@@ -129,10 +130,14 @@ class BearingCoupling:
                 np.einsum('lai,la,laj->ij', self.pier, self.damping, self.pier))
 
     def on_pier(self, u: np.ndarray, v: np.ndarray) -> np.ndarray:
-        """Return the load on the pier top (6,) from the girder state (free u, v)."""
-        # elastic bearings leave every girder-end DOF free: no zero slot to gather
-        f = (self.stiffness * np.einsum('lai,li->la', self.girder, u[self.girder_dofs])
-             + self.damping * np.einsum('lai,li->la', self.girder, v[self.girder_dofs]))
+        """
+        Return the load on the pier top (6,) from the girder-end state.
+
+        ``u`` and ``v`` are (n_links, 6), at :attr:`girder_dofs` (elastic bearings
+        leave every girder-end DOF free: no zero slot to gather).
+        """
+        f = (self.stiffness * np.einsum('lai,li->la', self.girder, u)
+             + self.damping * np.einsum('lai,li->la', self.girder, v))
         return -np.einsum('lai,la->i', self.pier, f)
 
     def on_girders(self, top_u: np.ndarray, top_v: np.ndarray) -> np.ndarray:
@@ -196,14 +201,20 @@ class PiledFoundations:
             np.add.at(ext, coupling.girder_dofs.ravel(), loads.ravel())
         self.integrator.external = ext[:self.n_free]
 
-    def after_step(self, u: np.ndarray, v: np.ndarray) -> None:
-        """Advance the substructures when the bridge has reached a macro-step end (free u, v)."""
+    def after_step(self, bridge_state: Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]]
+                   ) -> None:
+        """
+        Advance the substructures when the bridge has reached a macro-step end.
+
+        ``bridge_state(dofs)`` returns the bridge's (u, v) at free DOFs ``dofs``
+        (:meth:`Coupling.bridge_state`); it is called at macro-step ends only.
+        """
         self.step_index += 1
         if self.step_index % self.substeps:
             return
         for i, (coupling, solver) in enumerate(zip(self.couplings, self.solvers)):
             force = np.zeros(self.piers[i].operator.size)
-            force[TOP] = coupling.on_pier(u, v)
+            force[TOP] = coupling.on_pier(*bridge_state(coupling.girder_dofs))
             self.states[i] = solver.step(self.states[i], force)
 
     def _predicted(self, i: int, step: int, dofs: slice | np.ndarray = slice(None)

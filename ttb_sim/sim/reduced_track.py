@@ -342,6 +342,7 @@ class ReducedTrainTrackCoupling(TrainTrackCoupling):
                  car_length: float, structure: Structure, integrator: Integrator,
                  irregularity: TrackIrregularity | None) -> None:
         super().__init__(car, contact, n_cars, car_length, structure, integrator, irregularity)
+        self._outer = integrator
         self._dt = float(integrator.dt)
         self._method = str(integrator.method)
         self.window: TrackWindow | None = None
@@ -417,7 +418,17 @@ class ReducedTrainTrackCoupling(TrainTrackCoupling):
         rear, front = self._axle_span(head)
         if front + FRONT_MARGIN > self.window.end or rear < self.window.start:
             self._move_window(head)
+        # Loads on the free DOFs (the bearing forces of partitioned piled piers) act on
+        # bridge DOFs, which the window keeps as they are.
+        external = self._outer.external
+        self.nm.external = None if external is None else external[self.window.kept]
         super().step(head, speed)
+
+    def bridge_state(self, dofs: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Return (u, v) at free bridge DOFs ``dofs``: every bridge DOF is a window DOF."""
+        assert self.window is not None, 'start() first'
+        solved = np.searchsorted(self.window.kept, dofs)
+        return self.u[solved], self.v[solved]
 
     def structure_state(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """

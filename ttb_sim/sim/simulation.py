@@ -276,7 +276,7 @@ class Simulation:
                 fd.before_step()
             cp.step(head, self.speed)
             if fd is not None:
-                fd.after_step(*cp.structure_state()[:2])
+                fd.after_step(cp.bridge_state)
                 self._check_state(step, *cp.monitored(), *(s.u for s in fd.current()))
             else:
                 self._check_state(step, *cp.monitored())

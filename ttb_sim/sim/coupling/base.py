@@ -63,6 +63,9 @@ class Coupling(Protocol):
     def structure_state(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Return the structure's (u, v, a) on the free DOFs."""
 
+    def bridge_state(self, dofs: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Return the structure's (u, v) at free bridge DOFs ``dofs`` (girders, bearings)."""
+
     def structure_load(self, head: float) -> np.ndarray:
         """Return the load applied to all DOFs (N), for the reactions of rigid supports."""
 

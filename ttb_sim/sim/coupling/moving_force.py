@@ -91,6 +91,10 @@ class MovingForceCoupling:
         """Return the girder state (u, v, a) on the free DOFs."""
         return self.u, self.v, self.a
 
+    def bridge_state(self, dofs: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Return (u, v) at the free DOFs ``dofs``."""
+        return self.u[dofs], self.v[dofs]
+
     def structure_load(self, head: float) -> np.ndarray:
         """Return the axle forces on all DOFs."""
         return self._full_load(head)

@@ -339,6 +339,10 @@ class QuarterCarTrain:
         """Return the girder state (u, v, a) on the free DOFs."""
         return self.u, self.v, self.a
 
+    def bridge_state(self, dofs: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Return (u, v) at the free DOFs ``dofs``."""
+        return self.u[dofs], self.v[dofs]
+
     def structure_load(self, head: float) -> np.ndarray:
         """Return the wheel contact forces (the static loads at the start) on all DOFs."""
         st, kernel = self.structure, self.kernel

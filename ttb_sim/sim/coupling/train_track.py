@@ -919,6 +919,10 @@ class TrainTrackCoupling:
         """Return the track-bridge state (u, v, a) on the free DOFs."""
         return self.u, self.v, self.a
 
+    def bridge_state(self, dofs: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Return (u, v) at the free DOFs ``dofs``."""
+        return self.u[dofs], self.v[dofs]
+
     def structure_load(self, head: float) -> np.ndarray:
         """Return zero: the wheel loads act through the rails, not on the girder DOFs."""
         return self._no_load
