@@ -27,7 +27,8 @@ Wheel-rail contact: the public face of the modules of this package.
 from ttb_sim.model.wheel_rail.creep import (creep_coefficients, CREEP_LOAD_EXPONENTS,
                                             FRICTION_COEFFICIENT, kalker_coefficients,
                                             KALKER_RATIO_RANGE, linear_creep_forces,
-                                            scale_creep_coefficients, she_factor_derivative,
+                                            scale_creep_coefficients, scaled_creep_coefficients,
+                                            she_factor_derivative,
                                             she_factor_gradient, she_ratio, she_saturation)
 from ttb_sim.model.wheel_rail.geometry import creepages, simplified_geometry, WheelsetGeometry
 from ttb_sim.model.wheel_rail.hertz import (hertz_constant, hertz_ellipse, HertzEllipse,
@@ -63,6 +64,7 @@ __all__ = [
     'normal_force_derivative',
     'rail_profile',
     'scale_creep_coefficients',
+    'scaled_creep_coefficients',
     'she_factor_derivative',
     'she_factor_gradient',
     'she_ratio',

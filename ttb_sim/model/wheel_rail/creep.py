@@ -49,6 +49,7 @@ __all__ = [
     'kalker_coefficients',
     'linear_creep_forces',
     'scale_creep_coefficients',
+    'scaled_creep_coefficients',
     'she_factor_derivative',
     'she_factor_gradient',
     'she_ratio',
@@ -239,6 +240,17 @@ def scale_creep_coefficients(coefficients: tuple[ArrayLike, ArrayLike, ArrayLike
 
     """
     check_positive('reference load', reference_load)
+    return scaled_creep_coefficients(coefficients, reference_load, load)
+
+
+def scaled_creep_coefficients(coefficients: tuple[ArrayLike, ArrayLike, ArrayLike, ArrayLike],
+                              reference_load: float, load: ArrayLike) -> tuple[
+                                  np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """
+    Return :func:`scale_creep_coefficients` without checking ``reference_load``.
+
+    For a time step whose reference load was checked once, before the run.
+    """
     ratio = np.maximum(np.asarray(load, dtype=float), 0.0) / reference_load
     f11, f22, f23, f33 = (np.asarray(c, dtype=float) for c in coefficients)
     e11, e22, e23, e33 = CREEP_LOAD_EXPONENTS

@@ -353,6 +353,8 @@ class TrainTrackCoupling:
         self.creep0 = ct.creep_coefficients(ellipse.a, ellipse.b)
         self.table: ContactGeometryTable | None = (
             contact_geometry_table() if cc.geometry == 'profiles' else None)
+        self._tables = self._geometry_tables()
+        """The profile table's columns for the compiled step (constant)."""
         track = structure.track
         if track is None:
             raise ModelError('multibody cars need the slab track: the structure has none')
@@ -833,7 +835,7 @@ class TrainTrackCoupling:
         wv0 = a1 * w0 + qh_v @ self.h.T
         normal = np.maximum(self.force[..., 2], 0.0)
         f11, f22, f23, f33 = (np.ascontiguousarray(np.broadcast_to(f, (n, 8))) for f in
-                              ct.scale_creep_coefficients(self.creep0, self.p0, normal))
+                              ct.scaled_creep_coefficients(self.creep0, self.p0, normal))
         r0p = np.zeros((n, 8, COMPONENTS))
         r0p[..., :3] = r_star
         rv0 = np.zeros((n, 8, COMPONENTS))
@@ -843,7 +845,7 @@ class TrainTrackCoupling:
         slope_offset = self._slope_offset.copy()
         y_star = np.ascontiguousarray(q_star[:, self._wheelset_y])
         ey = np.ascontiguousarray(self.ey)
-        lateral, radius_table, angle_table, rise, roll = self._geometry_tables()
+        lateral, radius_table, angle_table, rise, roll = self._tables
         g = self.force.reshape(n, m).copy()
         y_rel = np.empty((n, 8))
         delta = np.empty((n, 8))
