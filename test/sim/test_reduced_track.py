@@ -239,3 +239,18 @@ def test_reduced_track_carries_partitioned_piled_piers():
     for name, a, b, tol in zip(('piles', 'bearings', 'mid-span'), reduced, full,
                                (1e-6, 1e-4, 1e-3)):
         assert np.sqrt(np.mean((a - b)**2)) <= tol * np.sqrt(np.mean(b**2)), name
+
+
+@pytest.mark.parametrize('gap', [0.07, 0.0])
+def test_slab_joints_are_where_the_units_end_with_or_without_a_gap(gap):
+    """Every joint between slab units is found, one unit length apart, and cuts both rails."""
+    scenario = load_scenario('moving_force_beam', values=SMALL + [('track.slab_gap', gap)])
+    structure = build_structure(scenario)
+    joints = slab_joints(structure)
+    track = scenario.track
+    pitch = track.fasteners_per_slab * track.fastener_spacing
+    slab = structure.track.slab
+    units = round((slab.start[-1] + slab.length[-1] - slab.start[0] + gap) / pitch)
+    assert joints.size == units - 1
+    np.testing.assert_allclose(np.diff(joints), pitch, rtol=1e-9)
+    assert rail_cuts(structure, joints).size == 2 * 6 * joints.size

@@ -166,14 +166,19 @@ class StaticTrackBasis:
 
 
 def slab_joints(structure: Structure) -> np.ndarray:
-    """Return the positions of the gaps between slab units (m, increasing)."""
+    """
+    Return the positions of the joints between slab units (m, increasing).
+
+    A joint is where consecutive slab elements share no node (a unit ends), with
+    or without a gap between them.
+    """
     track = structure.track
     if track is None:
         raise ValueError('the reduced track needs a structure with a track')
     slab = track.slab
-    end = slab.start[:-1] + slab.length[:-1]
-    gap = np.flatnonzero(slab.start[1:] - end > 1e-9 * slab.length.max())
-    return 0.5 * (end[gap] + slab.start[1:][gap])
+    joint = np.flatnonzero(slab.dofs[1:, 0] != slab.dofs[:-1, 6])
+    end = slab.start[joint] + slab.length[joint]
+    return 0.5 * (end + slab.start[joint + 1])
 
 
 def rail_cuts(structure: Structure, joints: np.ndarray) -> np.ndarray:
