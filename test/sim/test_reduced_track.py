@@ -254,3 +254,20 @@ def test_slab_joints_are_where_the_units_end_with_or_without_a_gap(gap):
     assert joints.size == units - 1
     np.testing.assert_allclose(np.diff(joints), pitch, rtol=1e-9)
     assert rail_cuts(structure, joints).size == 2 * 6 * joints.size
+
+
+def test_window_margin_key_sets_the_window():
+    """``solver.window_margin`` (default the module's MARGIN) widens the detailed track."""
+    from ttb_sim.config.records import SolverConfig
+    assert SolverConfig().window_margin == reduced_track.MARGIN
+    sizes = []
+    for margin in (10.0, 60.0):
+        sim = Simulation(load_scenario('moving_force_beam', values=SMALL + [
+            ('solver.variant', 'reduced'), ('solver.duration', 0.002),
+            ('solver.window_margin', margin)]))
+        list(sim.frames())
+        window = sim.coupling.window
+        rear = sim.scenario.train.start_position + float(np.min(sim.coupling.contact_x))
+        assert window.start <= rear - margin < window.start + 6.0   # widened to a joint
+        sizes.append(window.size)
+    assert sizes[0] < sizes[1]

@@ -148,6 +148,10 @@ class SolverConfig:
                           "multi-time-step); 'monolithic' solves them as one system ([P] "
                           'Eq. 11, the reference; substructure_steps must be 1).',
                           choices=('partitioned', 'monolithic'))
+    window_margin: float = param(30.0, 'm', "solver.variant 'reduced': detailed track kept "
+                                 'behind the last axle and ahead of the first; more keeps '
+                                 "more of the track's waves at more cost (README, "
+                                 'Benchmark).', low=5.0, high=10000.0)
 
 
 @dataclass(frozen=True)

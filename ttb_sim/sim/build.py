@@ -189,9 +189,12 @@ def build_coupling(scenario: Scenario, structure: Structure, vehicle: Vehicle,
 
     """
     if isinstance(vehicle, MultibodyCars):
-        coupling = ReducedTrainTrackCoupling if reduced else TrainTrackCoupling
-        return coupling(scenario.car, scenario.contact, vehicle.n_cars,
-                        vehicle.car_length, structure, integrator, irregularity)
+        if reduced:
+            return ReducedTrainTrackCoupling(scenario.car, scenario.contact, vehicle.n_cars,
+                                             vehicle.car_length, structure, integrator,
+                                             irregularity, scenario.solver.window_margin)
+        return TrainTrackCoupling(scenario.car, scenario.contact, vehicle.n_cars,
+                                  vehicle.car_length, structure, integrator, irregularity)
     if isinstance(vehicle, QuarterCars):
         return QuarterCarTrain(vehicle, structure, integrator, irregularity)
     return MovingForceCoupling(vehicle, structure, integrator, lean=lean)
