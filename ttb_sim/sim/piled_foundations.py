@@ -25,7 +25,7 @@ the part of F that depends on its own DOFs in its own implicit matrices (O:
 the links to a fixed pier top; U: G_p^T k G_p on the pier top) and receives
 the other part as a load:
 
-- on the girders, -G_g^T [k G_p u_p + c G_p v_p] (:attr:`Integrator.external`);
+- on the girders, -G_g^T [k G_p u_p + c G_p v_p] (:meth:`Coupling.load_bridge`);
 - on the pier top, -G_p^T [k G_g u_g + c G_g v_g].
 
 Multi-time-step ([P] Eqs. 13-14; PHYSICS.md section 7): O advances at dt, U
@@ -67,7 +67,6 @@ import scipy.linalg as sla
 
 from ttb_sim.model.bridge import PiledPier, Structure
 from ttb_sim.model.foundation.operator import TOP
-from ttb_sim.sim.integrators.protocol import Integrator
 
 
 @dataclass
@@ -149,28 +148,29 @@ class BearingCoupling:
 
 class PiledFoundations:
     """
-    The partitioned piled piers of a structure, stepped with the bridge's integrator.
+    The partitioned piled piers of a structure, stepped beside the bridge.
+
+    The bridge's coupling exchanges the bearing forces with them before and
+    after every bridge step (:meth:`before_step`, :meth:`after_step`).
 
     Parameters
     ----------
     structure : Structure
         The bridge, assembled with the piled piers left out (partitioned).
-    integrator : Integrator
-        The bridge's integrator; its :attr:`~Integrator.external` load is set
-        before every step.
+    dt : float
+        The bridge's time step (s).
     substeps : int
         n: bridge steps per substructure step.
 
     """
 
-    def __init__(self, structure: Structure, integrator: Integrator, substeps: int) -> None:
+    def __init__(self, structure: Structure, dt: float, substeps: int) -> None:
         self.piers = tuple(p for p in structure.piled if p.block is None)
         self.substeps = int(substeps)
-        self.integrator = integrator
-        self.n_free = structure.n_free
+        self.dt = float(dt)
         self.n_supports = structure.n_supports
         self.couplings = tuple(BearingCoupling.of(structure, p) for p in self.piers)
-        dt_u = integrator.dt * self.substeps
+        dt_u = self.dt * self.substeps
         self.solvers = []
         for pier, coupling in zip(self.piers, self.couplings):
             op = pier.operator
@@ -182,7 +182,11 @@ class PiledFoundations:
         self.states = [PierState(np.zeros(p.operator.size), np.zeros(p.operator.size),
                                  np.zeros(p.operator.size)) for p in self.piers]
         """Each substructure's state at the last macro-step end."""
-        self._external = np.zeros(self.n_free + 1)
+        girder_dofs = np.concatenate([c.girder_dofs.ravel() for c in self.couplings]
+                                     or [np.zeros(0, dtype=np.intp)])
+        self._girder_dofs, self._slot = np.unique(girder_dofs, return_inverse=True)
+        """The girder DOFs the bearings load (unique), and each link DOF's place among them."""
+        self._loads = np.zeros(self._girder_dofs.size)
         self.step_index = 0
         """Bridge steps taken."""
 
@@ -191,15 +195,23 @@ class PiledFoundations:
         """True when there is anything to step."""
         return bool(self.piers)
 
-    def before_step(self) -> None:
-        """Load the girders with the pier tops predicted at the end of this bridge step."""
-        ext = self._external
-        ext.fill(0.0)
-        for i, coupling in enumerate(self.couplings):
-            state = self._predicted(i, self.step_index + 1, TOP)
-            loads = coupling.on_girders(state.u, state.v)
-            np.add.at(ext, coupling.girder_dofs.ravel(), loads.ravel())
-        self.integrator.external = ext[:self.n_free]
+    def before_step(self, load_bridge: Callable[[np.ndarray, np.ndarray], None]) -> None:
+        """
+        Load the girders with the pier tops predicted at the end of this bridge step.
+
+        ``load_bridge(dofs, values)`` adds the bearing forces to the bridge's next
+        step (:meth:`Coupling.load_bridge`).
+        """
+        loads = np.concatenate([
+            coupling.on_girders(*self._predicted_top(i)).ravel()
+            for i, coupling in enumerate(self.couplings)])
+        self._loads.fill(0.0)
+        np.add.at(self._loads, self._slot, loads)
+        load_bridge(self._girder_dofs, self._loads)
+
+    def _predicted_top(self, i: int) -> tuple[np.ndarray, np.ndarray]:
+        state = self._predicted(i, self.step_index + 1, TOP)
+        return state.u, state.v
 
     def after_step(self, bridge_state: Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]]
                    ) -> None:
@@ -222,7 +234,7 @@ class PiledFoundations:
         """Return pier ``i``'s state (``dofs``) at bridge step ``step`` of this macro step."""
         s = self.states[i]
         u, v, a = s.u[dofs], s.v[dofs], s.a[dofs]
-        tau = (step - self.substeps * (self.step_index // self.substeps)) * self.integrator.dt
+        tau = (step - self.substeps * (self.step_index // self.substeps)) * self.dt
         return PierState(u + tau * v + 0.5 * tau**2 * a, v + tau * a, a)
 
     def current(self) -> list[PierState]:

@@ -103,6 +103,9 @@ class TrackWindow:
         mass and damping, so that they stay as sparse as the full model's).
     kept : numpy.ndarray
         (n_reduced,) free index of each reduced DOF (increasing).
+    free_to_reduced : numpy.ndarray
+        (n_free + 1,) reduced index of each free DOF and of the ground slot;
+        ``n_reduced`` where the DOF is not a reduced one.
     full_to_reduced : numpy.ndarray
         (n_full,) reduced index of each full DOF; ``n_reduced`` (the ground
         slot) where the DOF is not a reduced one.
@@ -114,6 +117,7 @@ class TrackWindow:
     basis: sp.csr_matrix
     local_basis: sp.csr_matrix
     kept: np.ndarray
+    free_to_reduced: np.ndarray
     full_to_reduced: np.ndarray
 
     @property
@@ -320,8 +324,8 @@ def track_window(structure: Structure, static: StaticTrackBasis, rigid: sp.csr_m
                                np.concatenate([np.arange(n_red), free_to_red[coo.col]]))),
                              shape=(n_free, n_red))
 
-    full_to_red = free_to_red[structure.full_to_free]
-    return TrackWindow(start, end, basis(static.basis), basis(rigid), kept, full_to_red)
+    return TrackWindow(start, end, basis(static.basis), basis(rigid), kept, free_to_red,
+                       free_to_red[structure.full_to_free])
 
 
 def project(matrix: sp.spmatrix, basis: sp.csr_matrix) -> sp.csr_matrix:
@@ -353,7 +357,8 @@ class ReducedTrainTrackCoupling(TrainTrackCoupling):
                  irregularity: TrackIrregularity | None, margin: float = MARGIN) -> None:
         self.margin = float(margin)
         super().__init__(car, contact, n_cars, car_length, structure, integrator, irregularity)
-        self._outer = integrator
+        self._bridge_load: tuple[np.ndarray, np.ndarray] | None = None
+        """The latest :meth:`load_bridge` (free DOFs, values), carried to each window."""
         self._dt = float(integrator.dt)
         self._method = str(integrator.method)
         self.window: TrackWindow | None = None
@@ -405,11 +410,10 @@ class ReducedTrainTrackCoupling(TrainTrackCoupling):
         self.n_free = window.size
         ftr = window.full_to_reduced
         self.rail_dofs = tuple(ftr[r.dofs] for r in self.rails)
-        free_to_red = np.full(st.n_free + 1, window.size)
-        free_to_red[window.kept] = np.arange(window.size)
-        self.compliance = self._full_compliance.restricted(free_to_red, window.size)
+        self.compliance = self._full_compliance.restricted(window.free_to_reduced, window.size)
         self.u, self.v, self.a = (s[window.kept].copy() for s in state)
         self.window = window
+        self._apply_bridge_load()
         self.window_moves += 1
         self.window_time += time.process_time() - begin
         log.debug('track window %.1f .. %.1f m: %d of %d DOFs', window.start, window.end,
@@ -429,17 +433,23 @@ class ReducedTrainTrackCoupling(TrainTrackCoupling):
         rear, front = self._axle_span(head)
         if front + self.margin > self.window.end or rear < self.window.start:
             self._move_window(head)
-        # Loads on the free DOFs (the bearing forces of partitioned piled piers) act on
-        # bridge DOFs, which the window keeps as they are.
-        external = self._outer.external
-        self.nm.external = None if external is None else external[self.window.kept]
         super().step(head, speed)
 
     def bridge_state(self, dofs: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Return (u, v) at free bridge DOFs ``dofs``: every bridge DOF is a window DOF."""
         assert self.window is not None, 'start() first'
-        solved = np.searchsorted(self.window.kept, dofs)
+        solved = self.window.free_to_reduced[dofs]
         return self.u[solved], self.v[solved]
+
+    def load_bridge(self, dofs: np.ndarray, values: np.ndarray) -> None:
+        """Add ``values`` at free bridge DOFs ``dofs`` to the next step's load (any window)."""
+        self._bridge_load = (dofs, values)
+        self._apply_bridge_load()
+
+    def _apply_bridge_load(self) -> None:
+        if self._bridge_load is not None and self.window is not None:
+            dofs, values = self._bridge_load
+            self.nm.external = (self.window.free_to_reduced[dofs], values)
 
     def structure_state(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """

@@ -139,7 +139,7 @@ class Simulation:
             self.coupling = build_coupling(scenario, st, self.vehicle, self.integrator,
                                            self.irregularity, lean=self.variant.lean,
                                            reduced=self.variant.reduced)
-        self.foundations = PiledFoundations(st, self.integrator,
+        self.foundations = PiledFoundations(st, dt,
                                             scenario.solver.substructure_steps)
         self.rigid = RigidDisplacement(st)
         b, pr = scenario.bridge, scenario.piers
@@ -273,7 +273,7 @@ class Simulation:
         for step in range(1, self.n_steps + 1):
             head += self.speed * dt
             if fd is not None:
-                fd.before_step()
+                fd.before_step(cp.load_bridge)
             cp.step(head, self.speed)
             if fd is not None:
                 fd.after_step(cp.bridge_state)

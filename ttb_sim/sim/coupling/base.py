@@ -30,8 +30,9 @@ from typing import Protocol
 import numpy as np
 
 from ttb_sim.model.bridge import GirderLine
+from ttb_sim.sim.integrators.protocol import Integrator
 
-__all__ = ['Coupling', 'girder_wheel_load', 'VehicleOutputs']
+__all__ = ['Coupling', 'FreeDofState', 'girder_wheel_load', 'VehicleOutputs']
 
 
 @dataclass(frozen=True)
@@ -66,6 +67,9 @@ class Coupling(Protocol):
     def bridge_state(self, dofs: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Return the structure's (u, v) at free bridge DOFs ``dofs`` (girders, bearings)."""
 
+    def load_bridge(self, dofs: np.ndarray, values: np.ndarray) -> None:
+        """Add ``values`` at free bridge DOFs ``dofs`` (unique) to the next step's load."""
+
     def structure_load(self, head: float) -> np.ndarray:
         """Return the load applied to all DOFs (N), for the reactions of rigid supports."""
 
@@ -74,6 +78,32 @@ class Coupling(Protocol):
 
     def vehicle_outputs(self) -> VehicleOutputs:
         """Return the vehicle's part of the current frame."""
+
+
+class FreeDofState:
+    """
+    The structure side of a coupling that solves the structure on its free DOFs.
+
+    Gives :class:`Coupling`'s structure state and bridge access from the
+    coupling's ``u``, ``v``, ``a`` and its integrator ``nm``.
+    """
+
+    nm: Integrator
+    u: np.ndarray
+    v: np.ndarray
+    a: np.ndarray
+
+    def structure_state(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Return the structure state (u, v, a) on the free DOFs."""
+        return self.u, self.v, self.a
+
+    def bridge_state(self, dofs: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Return (u, v) at the free DOFs ``dofs``."""
+        return self.u[dofs], self.v[dofs]
+
+    def load_bridge(self, dofs: np.ndarray, values: np.ndarray) -> None:
+        """Add ``values`` at the free DOFs ``dofs`` (unique) to the next step's load."""
+        self.nm.external = (dofs, values)
 
 
 def girder_wheel_load(girder: GirderLine, n_full: int, positions: np.ndarray,

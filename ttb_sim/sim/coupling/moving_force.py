@@ -20,14 +20,14 @@ import numpy as np
 
 from ttb_sim.model.bridge import Structure
 from ttb_sim.model.vehicle.train import MovingForces
-from ttb_sim.sim.coupling.base import girder_wheel_load, VehicleOutputs
+from ttb_sim.sim.coupling.base import FreeDofState, girder_wheel_load, VehicleOutputs
 from ttb_sim.sim.integrators.protocol import Integrator
 from ttb_sim.sim.lean import MovingLoad
 
 __all__ = ['MovingForceCoupling']
 
 
-class MovingForceCoupling:
+class MovingForceCoupling(FreeDofState):
     """
     Constant vertical forces crossing the girders (Fryba's moving-load problem).
 
@@ -86,14 +86,6 @@ class MovingForceCoupling:
             force = girder_wheel_load(st.girder, st.n_full, positions,
                                       self.forces.loads)[st.free]
         self.u, self.v, self.a = self.nm.step(self.u, self.v, self.a, force)
-
-    def structure_state(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """Return the girder state (u, v, a) on the free DOFs."""
-        return self.u, self.v, self.a
-
-    def bridge_state(self, dofs: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """Return (u, v) at the free DOFs ``dofs``."""
-        return self.u[dofs], self.v[dofs]
 
     def structure_load(self, head: float) -> np.ndarray:
         """Return the axle forces on all DOFs."""

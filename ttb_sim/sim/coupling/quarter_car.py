@@ -46,7 +46,7 @@ from ttb_sim.model.irregularity import TrackIrregularity
 from ttb_sim.model.irregularity._checks import GRID_SLACK
 from ttb_sim.model.vehicle.train import QuarterCars
 from ttb_sim.sim import quarter_car_kernels
-from ttb_sim.sim.coupling.base import girder_wheel_load, VehicleOutputs
+from ttb_sim.sim.coupling.base import FreeDofState, girder_wheel_load, VehicleOutputs
 from ttb_sim.sim.integrators.protocol import Integrator
 
 DENSE_GIRDER_LIMIT = 3000
@@ -268,7 +268,7 @@ class QuarterCarCoupling:
         return u_new, v_new, a_new
 
 
-class QuarterCarTrain:
+class QuarterCarTrain(FreeDofState):
     """
     Quarter cars on the girders as a :class:`~ttb_sim.sim.coupling.base.Coupling`.
 
@@ -334,14 +334,6 @@ class QuarterCarTrain:
         positions = head - self.cars.axles.offsets
         self.u, self.v, self.a = self.kernel.step(self.u, self.v, self.a, self._zero,
                                                   positions, speed, self._profile(positions))
-
-    def structure_state(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """Return the girder state (u, v, a) on the free DOFs."""
-        return self.u, self.v, self.a
-
-    def bridge_state(self, dofs: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """Return (u, v) at the free DOFs ``dofs``."""
-        return self.u[dofs], self.v[dofs]
 
     def structure_load(self, head: float) -> np.ndarray:
         """Return the wheel contact forces (the static loads at the start) on all DOFs."""

@@ -78,7 +78,7 @@ import ttb_sim.model.wheel_rail as ct
 from ttb_sim.model.wheel_rail.parameters import ContactParameters
 from ttb_sim.model.wheel_rail.profiles import contact_geometry_table, ContactGeometryTable
 from ttb_sim.sim import kernels
-from ttb_sim.sim.coupling.base import VehicleOutputs
+from ttb_sim.sim.coupling.base import FreeDofState, VehicleOutputs
 from ttb_sim.sim.integrators.protocol import Integrator
 from ttb_sim.sim.lean import point_rows_and_slopes
 
@@ -296,7 +296,7 @@ def neighbourhoods(integrator: Integrator, nodes: np.ndarray, hops: int) -> sp.c
     return reach
 
 
-class TrainTrackCoupling:
+class TrainTrackCoupling(FreeDofState):
     """
     State and coupled step of multibody cars running on the slab track.
 
@@ -916,14 +916,6 @@ class TrainTrackCoupling:
     def start(self, head: float) -> None:
         """Start from the static equilibrium of train and track under gravity."""
         self.equilibrium(head)
-
-    def structure_state(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """Return the track-bridge state (u, v, a) on the free DOFs."""
-        return self.u, self.v, self.a
-
-    def bridge_state(self, dofs: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """Return (u, v) at the free DOFs ``dofs``."""
-        return self.u[dofs], self.v[dofs]
 
     def structure_load(self, head: float) -> np.ndarray:
         """Return zero: the wheel loads act through the rails, not on the girder DOFs."""

@@ -69,9 +69,10 @@ class Newmark:
             self._history = np.zeros(2 * n)
             self._h_a, self._h_v = self._history[:n], self._history[n:]
             self._work = np.zeros(n)
-        self.external: np.ndarray | None = None
-        """Load added to every effective right-hand side: the bearing forces of
-        partitioned substructures on the girders, set before each step (None: none)."""
+        self.external: tuple[np.ndarray, np.ndarray] | None = None
+        """Load added to every effective right-hand side, (DOFs (unique), values): the
+        bearing forces of partitioned substructures on the girders, set before each step
+        (None: none)."""
         self._history_kernel = kernels.compiled('history') if lean else None
         self._finish_kernel = kernels.compiled('finish') if lean else None
 
@@ -107,7 +108,8 @@ class Newmark:
         else:
             rhs = force - self.mass @ h_a - self.damping @ h_v
         if self.external is not None:
-            rhs += self.external
+            dofs, values = self.external
+            rhs[dofs] += values
         return rhs
 
     def solve(self, rhs: np.ndarray) -> np.ndarray:

@@ -53,9 +53,10 @@ class Integrator(Protocol):
     """Stiffness matrix."""
     method: str
     """Sparse factorisation in use (:func:`ttb_sim.fe.factorization.factorize`)."""
-    external: np.ndarray | None
-    """Load at t_{n+1} that :meth:`effective_load` adds to the coupling's own (the
-    substructures' bearing forces on the girders, set by the driver before each step)."""
+    external: tuple[np.ndarray, np.ndarray] | None
+    """Load at t_{n+1} that :meth:`effective_load` adds to the coupling's own, as (DOFs
+    (unique), values): the substructures' bearing forces on the girders, set through
+    :meth:`~ttb_sim.sim.coupling.base.Coupling.load_bridge` before each step."""
 
     def history(self, u: np.ndarray, v: np.ndarray,
                 a: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
