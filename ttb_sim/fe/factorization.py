@@ -63,6 +63,10 @@ FALLBACKS = ('qdldl', 'cholmod', 'superlu_sym')
 SYMMETRY_TOLERANCE = 1e-12
 """Largest |A - A^T| accepted by the symmetric methods, relative to max |A|."""
 _PACKAGES = {'cholmod': 'cholespy', 'qdldl': 'qdldl'}
+SPLIT_METHODS = ('qdldl',)
+"""Methods whose solve releases the GIL, so that ``split`` halves run on two cores."""
+SPLIT_MIN_SIZE = 4000
+"""Fewest unknowns that ``split`` divides (below, the hand-over costs more than it saves)."""
 
 
 class Factorization(Protocol):
@@ -99,7 +103,8 @@ def resolve(method: str) -> str:
     return next(m for m in FALLBACKS if available(m))
 
 
-def factorize(matrix: sp.spmatrix | sp.sparray, *, method: str = 'superlu') -> Factorization:
+def factorize(matrix: sp.spmatrix | sp.sparray, *, method: str = 'superlu',
+              split: bool = False) -> Factorization:
     """
     Factorise a sparse square matrix once for repeated solves.
 
@@ -110,6 +115,12 @@ def factorize(matrix: sp.spmatrix | sp.sparray, *, method: str = 'superlu') -> F
     method : str
         One of :data:`METHODS`. A method whose package is missing falls back
         to the first available of :data:`FALLBACKS` (logged as a warning).
+    split : bool
+        Split a long, thin matrix at a small separator near its middle and
+        solve the two halves on two threads (:mod:`ttb_sim.fe.bisection`;
+        exact to round-off), when the method is one of :data:`SPLIT_METHODS`,
+        numba is installed and the matrix has at least :data:`SPLIT_MIN_SIZE`
+        unknowns and such a separator; otherwise as without.
 
     Returns
     -------
@@ -135,6 +146,15 @@ def factorize(matrix: sp.spmatrix | sp.sparray, *, method: str = 'superlu') -> F
         return _SuperLU(sla.splu(sp.csc_matrix(matrix)), used)
     csc = sp.csc_matrix(matrix)
     _check_symmetric(csc, used)
+    if split and used in SPLIT_METHODS and shape[0] >= SPLIT_MIN_SIZE and _numba():
+        from ttb_sim.fe.bisection import BisectedFactorization, level_bisection
+
+        halves = level_bisection(csc)
+        if halves is not None:
+            log.debug('solving %d unknowns as two halves of %d and %d and a separator of %d',
+                      shape[0], halves.first.size, halves.second.size, halves.separator.size)
+            return BisectedFactorization(csc, halves,
+                                         lambda block: factorize(block, method=used))
     if used == 'superlu_sym':
         lu = sla.splu(csc, permc_spec='MMD_AT_PLUS_A', diag_pivot_thresh=0.0,
                       options={'SymmetricMode': True})
@@ -142,6 +162,10 @@ def factorize(matrix: sp.spmatrix | sp.sparray, *, method: str = 'superlu') -> F
     if used == 'cholmod':
         return _Cholmod(csc)
     return _Qdldl(csc)
+
+
+def _numba() -> bool:
+    return importlib.util.find_spec('numba') is not None
 
 
 def _check_symmetric(matrix: sp.csc_matrix, method: str) -> None:
@@ -200,6 +224,11 @@ class _Qdldl:
 
         self._solver = qdldl.Solver(sp.triu(matrix, format='csc'), upper=True)
         self._solve: Callable[[np.ndarray], np.ndarray] = self._solver.solve
+
+    def factors(self) -> tuple[sp.csc_matrix, np.ndarray, np.ndarray]:
+        """Return (L strictly lower, D, p) with A[p][:, p] = (I + L) diag(D) (I + L)^T."""
+        lower, diagonal, permutation = self._solver.factors()
+        return sp.csc_matrix(lower), np.asarray(diagonal), np.asarray(permutation)
 
     def solve(self, rhs: np.ndarray) -> np.ndarray:
         """Return x with A x = rhs, for rhs of shape (n,) or (n, k)."""

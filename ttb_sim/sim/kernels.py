@@ -23,19 +23,15 @@ which computes the same numbers. The kernels are compiled on first use
 
 from __future__ import annotations
 
-import logging
-import sys
 from typing import Any, Callable
 
 import numpy as np
 
+from ttb_sim.fe.compiled import jit as compiled_jit
 from ttb_sim.sim import contact_kernels
-
-log = logging.getLogger(__name__)
 
 ENABLED = True
 """False makes :func:`compiled` return None, so the lean step takes the numpy twins."""
-_CACHE: dict[Callable[..., Any], Callable[..., Any] | None] = {}
 
 
 def compiled(name: str) -> Callable[..., Any] | None:
@@ -45,32 +41,11 @@ def compiled(name: str) -> Callable[..., Any] | None:
 
 def jit(kernel: Callable[..., Any]) -> Callable[..., Any] | None:
     """
-    Return ``kernel`` compiled by numba (on first call, with its module's helpers), or None.
+    Return ``kernel`` compiled by numba (:func:`ttb_sim.fe.compiled.jit`), or None.
 
-    None when numba is not installed or :data:`ENABLED` is False; numba is
-    imported only here, so the package imports without it and quickly.
+    None when numba is not installed or :data:`ENABLED` is False.
     """
-    if not ENABLED:
-        return None
-    if kernel not in _CACHE:
-        try:
-            import numba
-        except ImportError:  # pragma: no cover - depends on the installation
-            log.debug('numba is not installed; the lean step runs its numpy twins')
-            _CACHE[kernel] = None
-        else:
-            _jit_helpers(numba, kernel)
-            _CACHE[kernel] = numba.njit(cache=True, nogil=True)(kernel)
-    return _CACHE[kernel]
-
-
-def _jit_helpers(numba: Any, kernel: Callable[..., Any]) -> None:
-    """Compile the helpers a kernel calls (its module's ``HELPERS``) in place, once."""
-    module = sys.modules[kernel.__module__]
-    for helper in getattr(module, 'HELPERS', ()):
-        function = getattr(module, helper)
-        if not hasattr(function, 'py_func'):
-            setattr(module, helper, numba.njit(cache=True, nogil=True)(function))
+    return compiled_jit(kernel) if ENABLED else None
 
 
 def _moving_load(positions: np.ndarray, forces: np.ndarray, h: float, n_el: int,

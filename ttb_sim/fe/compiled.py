@@ -1,0 +1,77 @@
+# Copyright 2026 The ttb_sim Authors
+#
+# Licensed under the Apache License, Version 2.0 (the "License");
+# you may not use this file except in compliance with the License.
+# You may obtain a copy of the License at
+#
+#     http://www.apache.org/licenses/LICENSE-2.0
+#
+# Unless required by applicable law or agreed to in writing, software
+# distributed under the License is distributed on an "AS IS" BASIS,
+# WITHOUT WARRANTIES OR CONDITIONS OF ANY KIND, either express or implied.
+# See the License for the specific language governing permissions and
+# limitations under the License.
+
+"""
+numba compilation of the package's kernels, on first use and only where numba imports.
+
+A kernel's source is a plain Python function (it runs, slowly, without
+numba); :func:`jit` compiles it once, with the helpers its module lists in
+``HELPERS``, cached on disk where the package directory is writable. A kernel
+compiled ``parallel`` runs the ``prange`` loops of its module on numba's
+threads: the module binds ``prange = range`` for the plain function, and
+:func:`jit` rebinds it to ``numba.prange`` before compiling. numba is imported
+only here, so the package imports without it and quickly.
+"""
+
+from __future__ import annotations
+
+import logging
+import sys
+from typing import Any, Callable
+
+log = logging.getLogger(__name__)
+
+_CACHE: dict[tuple[Callable[..., Any], bool], Callable[..., Any] | None] = {}
+
+
+def jit(kernel: Callable[..., Any], *, parallel: bool = False) -> Callable[..., Any] | None:
+    """
+    Return ``kernel`` compiled by numba (on first call, with its module's helpers), or None.
+
+    Parameters
+    ----------
+    kernel : callable
+        The plain function.
+    parallel : bool
+        Compile with numba's ``parallel=True`` (its module's ``prange`` loops run
+        on several threads).
+
+    Returns
+    -------
+    callable or None
+        None when numba is not installed.
+
+    """
+    key = (kernel, parallel)
+    if key not in _CACHE:
+        try:
+            import numba
+        except ImportError:  # pragma: no cover - depends on the installation
+            log.debug('numba is not installed; kernels run their numpy twins')
+            _CACHE[key] = None
+        else:
+            module = sys.modules[kernel.__module__]
+            _jit_helpers(numba, module)
+            if parallel:
+                setattr(module, 'prange', numba.prange)
+            _CACHE[key] = numba.njit(cache=True, nogil=True, parallel=parallel)(kernel)
+    return _CACHE[key]
+
+
+def _jit_helpers(numba: Any, module: Any) -> None:
+    """Compile the helpers a module's kernels call (its ``HELPERS``) in place, once."""
+    for helper in getattr(module, 'HELPERS', ()):
+        function = getattr(module, helper)
+        if not hasattr(function, 'py_func'):
+            setattr(module, helper, numba.njit(cache=True, nogil=True)(function))
