@@ -39,13 +39,13 @@ def compiled(name: str) -> Callable[..., Any] | None:
     return jit(_KERNELS[name])
 
 
-def jit(kernel: Callable[..., Any]) -> Callable[..., Any] | None:
+def jit(kernel: Callable[..., Any], *, parallel: bool = False) -> Callable[..., Any] | None:
     """
     Return ``kernel`` compiled by numba (:func:`ttb_sim.fe.compiled.jit`), or None.
 
     None when numba is not installed or :data:`ENABLED` is False.
     """
-    return compiled_jit(kernel) if ENABLED else None
+    return compiled_jit(kernel, parallel=parallel) if ENABLED else None
 
 
 def _moving_load(positions: np.ndarray, forces: np.ndarray, h: float, n_el: int,
@@ -100,7 +100,23 @@ def _finish(u: np.ndarray, a0: float, a1: float, h_v: np.ndarray,
     return v, a
 
 
-_KERNELS: dict[str, Callable[..., Any]] = {
+def _effective_load(indptr: np.ndarray, indices: np.ndarray, data: np.ndarray,
+                    history: np.ndarray, force: np.ndarray, out: np.ndarray) -> None:
+    """
+    Fill out = force - A history (A in CSR, unsigned indices).
+
+    Each row's sum runs in scipy's order (from zero, entry by entry), so the
+    result is ``force - A @ history`` bit for bit; measured twice as fast as
+    scipy's mat-vec on the paper_ttbi matrices (README, Benchmark).
+    """
+    for i in range(out.shape[0]):
+        acc = 0.0
+        for p in range(indptr[i], indptr[i + 1]):
+            acc += data[p] * history[indices[p]]
+        out[i] = force[i] - acc
+
+
+_KERNELS: dict[str, Callable[..., Any]] = {'effective_load': _effective_load,
     'moving_load': _moving_load, 'history': _history, 'finish': _finish,
     'rail_rows': contact_kernels.rail_rows, 'rail_values': contact_kernels.rail_values,
     'rail_load': contact_kernels.rail_load, 'contact_newton': contact_kernels.contact_newton,
