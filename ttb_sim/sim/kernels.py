@@ -116,8 +116,9 @@ def _effective_load(indptr: np.ndarray, indices: np.ndarray, data: np.ndarray,
         out[i] = force[i] - acc
 
 
-_KERNELS: dict[str, Callable[..., Any]] = {'effective_load': _effective_load,
-    'moving_load': _moving_load, 'history': _history, 'finish': _finish,
+_KERNELS: dict[str, Callable[..., Any]] = {
+    'effective_load': _effective_load, 'moving_load': _moving_load, 'history': _history,
+    'finish': _finish,
     'rail_rows': contact_kernels.rail_rows, 'rail_values': contact_kernels.rail_values,
     'rail_load': contact_kernels.rail_load, 'contact_newton': contact_kernels.contact_newton,
     'rail_predictor': contact_kernels.rail_predictor,
