@@ -34,9 +34,14 @@ ENABLED = True
 """False makes :func:`compiled` return None, so the lean step takes the numpy twins."""
 
 
+PARALLEL = frozenset({'rail_predictor'})
+"""Kernels compiled ``parallel`` (their loop over cars on numba's threads; each car's
+arithmetic is the same on any thread, so the results do not depend on the thread count)."""
+
+
 def compiled(name: str) -> Callable[..., Any] | None:
     """Return the compiled lean-step kernel ``name`` (compiled on first call), or None."""
-    return jit(_KERNELS[name])
+    return jit(_KERNELS[name], parallel=name in PARALLEL)
 
 
 def jit(kernel: Callable[..., Any], *, parallel: bool = False) -> Callable[..., Any] | None:
