@@ -121,9 +121,17 @@ def _check_settings(out: Path, settings: dict[str, Any]) -> None:
                             '(no sweep.json); give a new or empty folder')
 
 
-def _ignore_interrupts() -> None:
-    """Worker initializer: Ctrl-C is the parent's to handle (it terminates the workers)."""
+def _start_worker(workers: int) -> None:
+    """
+    Worker initializer: Ctrl-C is the parent's to handle (it terminates the workers).
+
+    With several workers each runs its compiled kernels on one thread: the cores are
+    already shared out by the processes, and a kernel's second thread would only
+    contend with another case (the results do not depend on the thread count).
+    """
     signal.signal(signal.SIGINT, signal.SIG_IGN)
+    if workers > 1:
+        os.environ['NUMBA_NUM_THREADS'] = '1'
 
 
 class _Stopped(Exception):
@@ -144,7 +152,7 @@ class _Local:
     def __init__(self, workers: int) -> None:
         self.pool = ProcessPoolExecutor(max_workers=workers,
                                         mp_context=multiprocessing.get_context('spawn'),
-                                        initializer=_ignore_interrupts)
+                                        initializer=_start_worker, initargs=(workers,))
 
     def submit(self, cases: Sequence[CaseSpec]) -> None:
         """Queue the cases (this starts the worker processes)."""
