@@ -18,7 +18,8 @@ Finite elements without physics names: elements, assembly, numbering, factorisat
 ``beam`` (3-D Euler-Bernoulli), ``mindlin`` (MITC4 plate), ``assembly`` (COO-once
 sparse assembly and spring-dashpot links), ``dofs`` (:class:`DofMap`: full/free
 numbering, substructure blocks and interfaces), ``factorization`` (symmetric sparse
-direct solvers behind one function).
+direct solvers behind one function), ``bisection`` (a long matrix solved as two halves on
+two cores), ``compiled`` (numba compilation of the package's kernels).
 """
 
 from ttb_sim.fe.assembly import assemble, assemble_links, link_kinematics
