@@ -18,6 +18,7 @@ import numpy as np
 import pytest
 import scipy.sparse as sp
 from ttb_sim.fe import bisection as bs
+from ttb_sim.fe import compiled
 from ttb_sim.fe import factorization as fz
 
 pytest.importorskip('numba')
@@ -92,7 +93,7 @@ def test_one_thread_or_two_give_the_same_bits():
     split = fz.factorize(a, method='qdldl', split=True)
     b = np.random.default_rng(4).standard_normal(a.shape[0])
     parallel = split.solve(b)
-    with bs._THREADS:          # busy: the serial compilation of the kernel runs
+    with compiled.PARALLEL_LOCK:   # busy: the serial compilation of the kernel runs
         serial = split.solve(b)
     assert np.array_equal(parallel, serial)
     assert np.array_equal(split.solve(b), parallel)

@@ -50,7 +50,6 @@ one) is not split.
 from __future__ import annotations
 
 from dataclasses import dataclass
-import threading
 from typing import Any, Callable
 
 import numpy as np
@@ -75,9 +74,6 @@ HELPERS = ('_ldl_solve', '_finish_half')
 """Functions the kernel calls (:func:`ttb_sim.fe.compiled.jit` compiles them first)."""
 prange = range
 """The kernel's parallel loop; numba's ``prange`` once the parallel kernel is compiled."""
-_THREADS = threading.Lock()
-"""Held while the parallel kernel runs: a second caller at the same time takes the serial
-compilation of the same kernel (numba's thread pools do not all allow concurrent launches)."""
 
 
 @dataclass(frozen=True)
@@ -171,10 +167,10 @@ class BisectedFactorization:
 
     def __init__(self, matrix: sp.spmatrix | sp.sparray, bisection: Bisection,
                  factorize_block: Callable[[sp.csr_matrix], Any]) -> None:
-        kernel, serial = jit(bisected_solve, parallel=True), jit(bisected_solve)
-        if kernel is None or serial is None:
+        kernel = jit(bisected_solve, parallel=True)
+        if kernel is None:
             raise RuntimeError('BisectedFactorization needs numba')
-        self._kernel, self._serial = kernel, serial
+        self._kernel = kernel
         csr = sp.csr_matrix(matrix)
         self.bisection = bisection
         sep = bisection.separator
@@ -218,14 +214,8 @@ class BisectedFactorization:
                                    ).reshape(b.shape)
         b = np.ascontiguousarray(b)
         x = np.empty(self._n)
-        parallel = _THREADS.acquire(blocking=False)
-        try:
-            kernel = self._kernel if parallel else self._serial
-            kernel(*self._halves[0], *self._halves[1], self._sep, self._schur_inverse, b,
-                   self._work[0], self._work[1], x)
-        finally:
-            if parallel:
-                _THREADS.release()
+        self._kernel(*self._halves[0], *self._halves[1], self._sep, self._schur_inverse, b,
+                     self._work[0], self._work[1], x)
         return x
 
 

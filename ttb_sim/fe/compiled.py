@@ -20,19 +20,41 @@ numba); :func:`jit` compiles it once, with the helpers its module lists in
 ``HELPERS``, cached on disk where the package directory is writable. A kernel
 compiled ``parallel`` runs the ``prange`` loops of its module on numba's
 threads: the module binds ``prange = range`` for the plain function, and
-:func:`jit` rebinds it to ``numba.prange`` before compiling. numba is imported
-only here, so the package imports without it and quickly.
+:func:`jit` rebinds it to ``numba.prange`` before compiling. One thread of the
+process at a time runs a parallel kernel (not every numba thread pool allows
+concurrent launches); another thread calling meanwhile runs the kernel's serial
+compilation, which computes the same bits. numba is imported only here, so the
+package imports without it and quickly.
 """
 
 from __future__ import annotations
 
 import logging
 import sys
+import threading
 from typing import Any, Callable
 
 log = logging.getLogger(__name__)
 
 _CACHE: dict[tuple[Callable[..., Any], bool], Callable[..., Any] | None] = {}
+PARALLEL_LOCK = threading.Lock()
+"""Held while a parallel kernel runs (module docstring)."""
+
+
+class _OneAtATime:
+    """A parallel kernel that falls back to its serial compilation while another runs."""
+
+    def __init__(self, parallel: Callable[..., Any], serial: Callable[..., Any]) -> None:
+        self.parallel = parallel
+        self.serial = serial
+
+    def __call__(self, *args: Any) -> Any:
+        if PARALLEL_LOCK.acquire(blocking=False):
+            try:
+                return self.parallel(*args)
+            finally:
+                PARALLEL_LOCK.release()
+        return self.serial(*args)
 
 
 def jit(kernel: Callable[..., Any], *, parallel: bool = False) -> Callable[..., Any] | None:
@@ -45,7 +67,7 @@ def jit(kernel: Callable[..., Any], *, parallel: bool = False) -> Callable[..., 
         The plain function.
     parallel : bool
         Compile with numba's ``parallel=True`` (its module's ``prange`` loops run
-        on several threads).
+        on several threads), one caller at a time (module docstring).
 
     Returns
     -------
@@ -65,7 +87,12 @@ def jit(kernel: Callable[..., Any], *, parallel: bool = False) -> Callable[..., 
             _jit_helpers(numba, module)
             if parallel:
                 setattr(module, 'prange', numba.prange)
-            _CACHE[key] = numba.njit(cache=True, nogil=True, parallel=parallel)(kernel)
+                serial = jit(kernel)
+                assert serial is not None
+                _CACHE[key] = _OneAtATime(
+                    numba.njit(cache=True, nogil=True, parallel=True)(kernel), serial)
+            else:
+                _CACHE[key] = numba.njit(cache=True, nogil=True)(kernel)
     return _CACHE[key]
 
 
