@@ -56,7 +56,7 @@ import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.csgraph as csgraph
 
-from ttb_sim.fe.compiled import jit
+from ttb_sim.fe.compiled import jit, sparse_arrays
 
 MIN_SHARE = 0.4
 """Least share of the matrix entries in each half: the separator is sought where both
@@ -140,14 +140,6 @@ def level_bisection(matrix: sp.spmatrix | sp.sparray) -> Bisection | None:
     return Bisection(first, second, separator)
 
 
-def _unsigned_csr(matrix: sp.spmatrix | sp.sparray) -> tuple[np.ndarray, ...]:
-    """Return (indptr, indices, data) with unsigned indices (no wrap-around checks)."""
-    csr = sp.csr_matrix(matrix)
-    csr.sort_indices()
-    return (csr.indptr.astype(np.uint64), csr.indices.astype(np.uint64),
-            np.ascontiguousarray(csr.data, dtype=np.float64))
-
-
 class BisectedFactorization:
     """
     Solve A x = b as two halves at the same time and their separator (module docstring).
@@ -178,30 +170,27 @@ class BisectedFactorization:
         schur = csr[sep][:, sep].toarray()
         self._halves: list[tuple[np.ndarray, ...]] = []
         self._work: list[np.ndarray] = []
-        self.method = ''
         self.couplings_nnz = 0
         """Non-zeros kept in W_1 and W_2."""
-        for part in (bisection.first, bisection.second):
-            block = factorize_block(csr[part][:, part])
-            self.method = block.method
+        blocks = [factorize_block(csr[part][:, part])
+                  for part in (bisection.first, bisection.second)]
+        self.method: str = blocks[0].method
+        for part, block in zip((bisection.first, bisection.second), blocks):
             lower, diagonal, permutation = block.factors()
-            order = part[np.asarray(permutation, dtype=np.int64)]
-            couple = csr[sep][:, order]                       # (ns, n_i), factor order
+            permutation = np.asarray(permutation, dtype=np.int64)
+            order = part[permutation]
+            couple = sp.csr_matrix(csr[sep][:, order])      # (ns, n_i), factor order
             w = np.asarray(block.solve(csr[part][:, sep].toarray()),
-                           dtype=float).reshape(part.size, sep.size)
-            w = w[np.asarray(permutation, dtype=np.int64)]  # factor order
+                           dtype=float).reshape(part.size, sep.size)[permutation]
             schur -= couple @ w
             scale = np.max(np.abs(w), axis=0, keepdims=True)
             w[np.abs(w) < W_DROP * scale] = 0.0
             w_csr = sp.csr_matrix(w)
             self.couplings_nnz += w_csr.nnz
-            lower_csc = sp.csc_matrix(lower)
-            lower_csc.sort_indices()
-            self._halves.append((
-                lower_csc.indptr.astype(np.uint64), lower_csc.indices.astype(np.uint64),
-                np.ascontiguousarray(lower_csc.data, dtype=np.float64),
-                1.0 / np.asarray(diagonal, dtype=np.float64), order.astype(np.uint64),
-                *_unsigned_csr(w_csr), *_unsigned_csr(couple)))
+            self._halves.append((*sparse_arrays(sp.csc_matrix(lower)),
+                                 1.0 / np.asarray(diagonal, dtype=np.float64),
+                                 order.astype(np.uint64), *sparse_arrays(w_csr),
+                                 *sparse_arrays(couple)))
             self._work.append(np.empty(part.size))
         self._sep = sep.astype(np.uint64)
         self._schur_inverse = np.linalg.inv(0.5 * (schur + schur.T))

