@@ -137,3 +137,64 @@ def test_single_solve_step_solves_once_and_meets_the_contact_tolerance(monkeypat
     assert relative(f_tight, f_numpy) < 1e-5
     assert relative(m_tight[..., 2], m_numpy[..., 2]) < 1e-6
     assert relative(f_tight, f_numpy) < 0.2 * relative(f_single, f_numpy)
+
+
+def test_step_setup_and_rail_check_are_the_numpy_formulas():
+    """
+    The step's set-up and mismatch kernels against the numpy step's formulas.
+
+    Random values of every array; the mismatch's largest entry counts every
+    component for the single-solve step, only the vertical otherwise, and a NaN
+    is never below the tolerance.
+    """
+    rng = np.random.default_rng(3)
+    n = 2
+    force = rng.normal(size=(n, 8, 4)) * 1e5
+    creep0 = rng.uniform(1e6, 1e7, size=4)
+    exponents = np.array(train_track.ct.CREEP_LOAD_EXPONENTS)
+    r_star, rs_star, r_hist = (rng.normal(size=(n, 8, 3)) for _ in range(3))
+    dr, ds = rng.normal(size=(n, 8, 3, 3)), rng.normal(size=(n, 8, 3, 3))
+    q_star = rng.normal(size=(n, 42))
+    wheelset_y = 6 * np.repeat(np.arange(3, 7), 2) + 1
+    a1, speed, p0 = 2e4, 80.0, 7e4
+    creep, r0p, rv0 = np.empty((4, n, 8)), np.empty((n, 8, 4)), np.empty((n, 8, 4))
+    rvel, y_star = np.empty((n, 8, 3, 3)), np.empty((n, 8))
+    kernels.compiled('contact_setup')(force, creep0, exponents, p0, r_star, rs_star, r_hist,
+                                      dr, ds, a1, speed, q_star, wheelset_y, creep, r0p, rv0,
+                                      rvel, y_star)
+    expected = train_track.ct.scaled_creep_coefficients(tuple(creep0), p0, force[..., 2])
+    np.testing.assert_allclose(creep, np.array(expected), rtol=1e-15, atol=0)
+    np.testing.assert_array_equal(r0p[..., :3], r_star)
+    np.testing.assert_allclose(rv0[..., :3], a1 * r_star + r_hist + speed * rs_star,
+                               rtol=1e-15, atol=1e-15 * a1)
+    assert not np.any(r0p[..., 3]) and not np.any(rv0[..., 3])
+    np.testing.assert_allclose(rvel, a1 * dr + speed * ds, rtol=1e-15, atol=1e-15 * a1)
+    np.testing.assert_array_equal(y_star, q_star[:, wheelset_y])
+
+    size = 50
+    rows, slope = rng.normal(size=(n, 8, 3, 12)), rng.normal(size=(n, 8, 3, 12))
+    dofs = rng.integers(0, size + 1, size=(n, 8, 12))     # size: the ground slot
+    u = rng.normal(size=size)
+    offset = rng.normal(size=(n, 8, 4)) * 1e-3
+    slope_offset = rng.normal(size=(n, 8, 3)) * 1e-3
+    g = rng.normal(size=(n, 32))
+    ue = np.append(u, 0.0)
+    exact = np.einsum('cwij,cwj->cwi', rows, ue[dofs])
+    exact_slope = np.einsum('cwij,cwj->cwi', slope, ue[dofs])
+    gx = g.reshape(n, 8, 4)[..., :3]
+    miss = exact - ((r0p + offset)[..., :3] - np.einsum('cwij,cwj->cwi', dr, gx))
+    miss_slope = exact_slope - (rs_star + slope_offset - np.einsum('cwij,cwj->cwi', ds, gx))
+    check = kernels.compiled('rail_check')
+    for single in (True, False):
+        r_exact, mismatch, slope_mismatch = (np.empty((n, 8, 3)) for _ in range(3))
+        worst = check(rows, slope, u, dofs, r0p, offset, dr, ds, g, rs_star, slope_offset,
+                      single, r_exact, mismatch, slope_mismatch)
+        np.testing.assert_allclose(r_exact, exact, rtol=0, atol=1e-13)
+        np.testing.assert_allclose(mismatch, miss, rtol=0, atol=1e-13)
+        np.testing.assert_allclose(slope_mismatch, miss_slope if single else 0.0, rtol=0,
+                                   atol=1e-13)
+        counted = np.abs(miss if single else miss[..., 2])
+        assert worst == pytest.approx(counted.max(), rel=1e-13)
+    offset[1, 5, 2] = np.nan
+    assert check(rows, slope, u, dofs, r0p, offset, dr, ds, g, rs_star, slope_offset, False,
+                 r_exact, mismatch, slope_mismatch) == np.inf

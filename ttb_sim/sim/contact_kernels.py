@@ -31,6 +31,11 @@ uncompiled they are correct but slow.
   (the single-solve step).
 * :func:`rail_load`: the track load of the wheel forces.
 * :func:`rail_irregularity`: the rail irregularity under the wheels.
+* :func:`contact_setup`: the step's constants of the contact iteration (the creep
+  coefficients at the last step's loads, the rail's motion and velocity without
+  contact force, the wheelsets' lateral predictor).
+* :func:`rail_check`: the exact rail motion under the wheels after a track solve
+  and its mismatch from the local model the contact iteration used.
 * :func:`contact_newton`: the Newton iteration of the contact laws of every
   car (Hertz, contact geometry, Kalker's creep saturated by Shen-Hedrick-Elkins)
   on the local track model; per car 32 unknowns and one dense 32 x 32 solve
@@ -261,6 +266,131 @@ def rail_predictor(element: np.ndarray, side: np.ndarray, start_l: np.ndarray,
                 rs_out[c, k, i] = acc_s
 
 
+def contact_setup(force: np.ndarray, creep0: np.ndarray, exponents: np.ndarray, p0: float,
+                  r_star: np.ndarray, rs_star: np.ndarray, r_hist: np.ndarray,
+                  dr: np.ndarray, ds: np.ndarray, a1: float, speed: float,
+                  q_star: np.ndarray, wheelset_y: np.ndarray, creep: np.ndarray,
+                  r0p: np.ndarray, rv0: np.ndarray, rvel: np.ndarray,
+                  y_star: np.ndarray) -> None:
+    """
+    Fill the constants of one step's contact iteration.
+
+    Parameters
+    ----------
+    force : numpy.ndarray
+        (n, 8, 4) the last step's contact forces (their Fz scales the creep coefficients).
+    creep0, exponents : numpy.ndarray
+        (4,) Kalker's f11, f22, f23, f33 at the reference load ``p0`` (N) and the
+        exponents of their load scaling (:func:`scaled_creep_coefficients`).
+    r_star, rs_star, r_hist : numpy.ndarray
+        (n, 8, 3) rail-head motion and slope of the predictor under each wheel, and
+        the rail rows applied to the velocity history.
+    dr, ds : numpy.ndarray
+        (n, 8, 3, 3) local rail compliance of the motion and the slope.
+    a1, speed : float
+        2 / dt (1/s) and the train speed (m/s).
+    q_star : numpy.ndarray
+        (n, 42) the cars' predictor; ``wheelset_y`` (8,) the DOF of each wheel's
+        wheelset lateral displacement.
+    creep : numpy.ndarray
+        Out, (4, n, 8): f11, f22, f23, f33 of every wheel.
+    r0p, rv0 : numpy.ndarray
+        Out, (n, 8, 4): rail-head motion and velocity without contact force (the
+        fourth slot zero).
+    rvel : numpy.ndarray
+        Out, (n, 8, 3, 3): a1 dr + speed ds.
+    y_star : numpy.ndarray
+        Out, (n, 8): wheelset lateral displacement of the predictor.
+
+    """
+    n_cars, n_wheels = r_star.shape[0], r_star.shape[1]
+    for c in range(n_cars):
+        for k in range(n_wheels):
+            ratio = max(force[c, k, 2], 0.0) / p0
+            for t in range(4):
+                creep[t, c, k] = creep0[t] * ratio ** exponents[t]
+            y_star[c, k] = q_star[c, wheelset_y[k]]
+            for i in range(3):
+                r0p[c, k, i] = r_star[c, k, i]
+                rv0[c, k, i] = a1 * r_star[c, k, i] + r_hist[c, k, i] + speed * rs_star[c, k, i]
+                for j in range(3):
+                    rvel[c, k, i, j] = a1 * dr[c, k, i, j] + speed * ds[c, k, i, j]
+            r0p[c, k, 3] = 0.0
+            rv0[c, k, 3] = 0.0
+
+
+def rail_check(rows: np.ndarray, slope: np.ndarray, u: np.ndarray, dofs: np.ndarray,
+               r0p: np.ndarray, offset: np.ndarray, dr: np.ndarray, ds: np.ndarray,
+               g: np.ndarray, rs_star: np.ndarray, slope_offset: np.ndarray, single: bool,
+               r_exact: np.ndarray, mismatch: np.ndarray,
+               slope_mismatch: np.ndarray) -> float:
+    """
+    Compare the exact rail motion under the wheels with the contact iteration's local model.
+
+    The model is r = r0p + offset - dr g (and, for the single-solve step, the slope
+    rs_star + slope_offset - ds g).
+
+    Parameters
+    ----------
+    rows, slope : numpy.ndarray
+        (n, 8, 3, 12) rail-head rows and slopes; ``dofs`` (n, 8, 12) their DOFs.
+    u : numpy.ndarray
+        (n_free,) the track's end-of-step displacement.
+    r0p, offset : numpy.ndarray
+        (n, 8, 4) rail-head motion without contact force and the offset of the model.
+    dr, ds : numpy.ndarray
+        (n, 8, 3, 3) local rail compliance of the motion and the slope.
+    g : numpy.ndarray
+        (n, 32) the contact forces.
+    rs_star, slope_offset : numpy.ndarray
+        (n, 8, 3) the predictor's rail slope and the slope model's offset.
+    single : bool
+        The single-solve step: its slope mismatch is filled and every component
+        counts; otherwise the slope mismatch is zero and only the vertical counts.
+    r_exact, mismatch, slope_mismatch : numpy.ndarray
+        Out, (n, 8, 3): exact rail-head motion, its mismatch from the model and the
+        slope's.
+
+    Returns
+    -------
+    float
+        The largest mismatch that counts (m); infinite when one is not a number.
+
+    """
+    n_cars, n_wheels = dofs.shape[0], dofs.shape[1]
+    size = u.shape[0]
+    worst = 0.0
+    for c in range(n_cars):
+        for k in range(n_wheels):
+            o = COMPONENTS * k
+            for i in range(3):
+                acc = 0.0
+                acc_s = 0.0
+                for j in range(12):
+                    d = dofs[c, k, j]
+                    if d < size:
+                        acc += rows[c, k, i, j] * u[d]
+                        acc_s += slope[c, k, i, j] * u[d]
+                model = 0.0
+                model_s = 0.0
+                for j in range(3):
+                    model += dr[c, k, i, j] * g[c, o + j]
+                    model_s += ds[c, k, i, j] * g[c, o + j]
+                r_exact[c, k, i] = acc
+                miss = acc - ((r0p[c, k, i] + offset[c, k, i]) - model)
+                mismatch[c, k, i] = miss
+                if single:
+                    slope_mismatch[c, k, i] = acc_s - (
+                        (rs_star[c, k, i] + slope_offset[c, k, i]) - model_s)
+                else:
+                    slope_mismatch[c, k, i] = 0.0
+                if single or i == 2:
+                    size_miss = abs(miss)
+                    if not size_miss <= worst:
+                        worst = size_miss if size_miss == size_miss else math.inf
+    return worst
+
+
 def rail_irregularity(x: np.ndarray, side: np.ndarray, x_start: float, dx: float,
                       values: np.ndarray, slopes: np.ndarray, curvatures: np.ndarray,
                       slack: float, z: np.ndarray, y: np.ndarray, dy: np.ndarray) -> None:
@@ -335,11 +465,11 @@ def _interval(y: float, grid: np.ndarray) -> int:
     return int(np.searchsorted(grid, y, side='right')) - 1
 
 
-def contact_newton(g: np.ndarray, w0: np.ndarray, wv0: np.ndarray, rp: np.ndarray,
-                   rvp: np.ndarray, dw: np.ndarray, dr: np.ndarray, rvel: np.ndarray,
+def contact_newton(g: np.ndarray, w0: np.ndarray, wv0: np.ndarray, r0p: np.ndarray,
+                   rv0: np.ndarray, offset: np.ndarray, slope_offset: np.ndarray,
+                   dw: np.ndarray, dr: np.ndarray, rvel: np.ndarray,
                    ey: np.ndarray, y_star: np.ndarray, irr_y: np.ndarray, irr_z: np.ndarray,
-                   irr_dy: np.ndarray, side: np.ndarray, f11: np.ndarray, f22: np.ndarray,
-                   f23: np.ndarray, f33: np.ndarray, lateral: np.ndarray,
+                   irr_dy: np.ndarray, side: np.ndarray, creep: np.ndarray, lateral: np.ndarray,
                    radius_table: np.ndarray, angle_table: np.ndarray, rise: np.ndarray,
                    roll: np.ndarray, arm: float, conicity: float, r0: float, g_hertz: float,
                    friction: float, a1: float, speed: float, step: float, tol: float,
@@ -350,7 +480,8 @@ def contact_newton(g: np.ndarray, w0: np.ndarray, wv0: np.ndarray, rp: np.ndarra
 
     The quantities are those of :meth:`TrainTrackCoupling.step`: per car the end-of-step
     wheel motion w = w0 + Dw g (velocity wv0 + a1 Dw g), the rail-head motion under
-    each wheel r = rp - Dr g (velocity rvp - Rv g, Dr and Rv 3 x 3 per wheel), the
+    each wheel r = r0p + offset - Dr g (velocity rv0 + a1 offset + V slope_offset - Rv g,
+    Dr and Rv 3 x 3 per wheel), the
     wheelset lateral position y* + Ey g; the contact geometry from the profile table
     (``lateral`` not empty) or the equivalent cone (``conicity``).
 
@@ -360,9 +491,12 @@ def contact_newton(g: np.ndarray, w0: np.ndarray, wv0: np.ndarray, rp: np.ndarra
         (n, 32) contact forces (Fx, Fy, Fz, Mz per wheel): the start, then the solution.
     w0, wv0 : numpy.ndarray
         (n, 32) wheel contact-point motion and velocity without contact force.
-    rp, rvp : numpy.ndarray
-        (n, 32) rail-head motion and velocity under each wheel without contact
-        force (the x, y, z slots of each wheel; its fourth slot is unused).
+    r0p, rv0 : numpy.ndarray
+        (n, 8, 4) rail-head motion and velocity under each wheel without contact
+        force (x, y, z; the fourth slot is zero).
+    offset, slope_offset : numpy.ndarray
+        (n, 8, 4) and (n, 8, 3): the corrections of the local rail model (motion,
+        and slope for the velocity; zero for the two-solve step).
     dw : numpy.ndarray
         (32, 32) wheel compliance of a car: w = w0 + dw g.
     dr, rvel : numpy.ndarray
@@ -376,8 +510,8 @@ def contact_newton(g: np.ndarray, w0: np.ndarray, wv0: np.ndarray, rp: np.ndarra
         (n, 8) lateral and vertical irregularity and lateral slope under each wheel.
     side : numpy.ndarray
         (n, 8) +1 for a left wheel, -1 for a right one.
-    f11, f22, f23, f33 : numpy.ndarray
-        (n, 8) Kalker's creep coefficients.
+    creep : numpy.ndarray
+        (4, n, 8) Kalker's creep coefficients f11, f22, f23, f33.
     lateral, radius_table, angle_table, rise, roll : numpy.ndarray
         Profile contact-geometry table (:class:`ContactGeometryTable` columns);
         ``lateral`` empty for the equivalent cone.
@@ -445,10 +579,12 @@ def contact_newton(g: np.ndarray, w0: np.ndarray, wv0: np.ndarray, rp: np.ndarra
                     for j in range(3):
                         acc += dr[c, k, i, j] * g[c, o + j]
                         acc_v += rvel[c, k, i, j] * g[c, o + j]
-                    r[o + i] = rp[c, o + i] - acc
-                    rv[o + i] = rvp[c, o + i] - acc_v
-                r[o + 3] = rp[c, o + 3]
-                rv[o + 3] = rvp[c, o + 3]
+                    rp = r0p[c, k, i] + offset[c, k, i]
+                    rvp = rv0[c, k, i] + a1 * offset[c, k, i] + speed * slope_offset[c, k, i]
+                    r[o + i] = rp - acc
+                    rv[o + i] = rvp - acc_v
+                r[o + 3] = r0p[c, k, 3] + offset[c, k, 3]
+                rv[o + 3] = rv0[c, k, 3] + a1 * offset[c, k, 3]
             for k in range(n_wheels):
                 o = COMPONENTS * k
                 s = side[c, k]
@@ -499,7 +635,8 @@ def contact_newton(g: np.ndarray, w0: np.ndarray, wv0: np.ndarray, rp: np.ndarra
                 xi_x = (wv[o] - rv[o]) / speed + 1.0 - radius[0] / r0
                 xi_y = (wv[o + 1] - rv[o + 1] - speed * irr_dy[c, k]) / speed - w[o + 3]
                 xi_sp = wv[o + 3] * cosg / speed - s * sing / r0
-                c11, c22, c23, c33 = f11[c, k], f22[c, k], f23[c, k], f33[c, k]
+                c11, c22 = creep[0, c, k], creep[1, c, k]
+                c23, c33 = creep[2, c, k], creep[3, c, k]
                 lin_x = -c11 * xi_x
                 lin_y = -(c22 * xi_y + c23 * xi_sp)
                 lin_m = c23 * xi_y - c33 * xi_sp

@@ -127,4 +127,5 @@ _KERNELS: dict[str, Callable[..., Any]] = {
     'rail_rows': contact_kernels.rail_rows, 'rail_values': contact_kernels.rail_values,
     'rail_load': contact_kernels.rail_load, 'contact_newton': contact_kernels.contact_newton,
     'rail_predictor': contact_kernels.rail_predictor,
-    'rail_irregularity': contact_kernels.rail_irregularity}
+    'rail_irregularity': contact_kernels.rail_irregularity,
+    'contact_setup': contact_kernels.contact_setup, 'rail_check': contact_kernels.rail_check}

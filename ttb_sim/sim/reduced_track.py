@@ -357,6 +357,8 @@ class ReducedTrainTrackCoupling(TrainTrackCoupling):
                  irregularity: TrackIrregularity | None, margin: float = MARGIN) -> None:
         self.margin = float(margin)
         super().__init__(car, contact, n_cars, car_length, structure, integrator, irregularity)
+        self._contact_min = float(np.min(self.contact_x))
+        self._contact_max = float(np.max(self.contact_x))
         self._bridge_load: tuple[np.ndarray, np.ndarray] | None = None
         """The latest :meth:`load_bridge` (free DOFs, values), carried to each window."""
         self._dt = float(integrator.dt)
@@ -386,8 +388,8 @@ class ReducedTrainTrackCoupling(TrainTrackCoupling):
         return self._full_compliance
 
     def _axle_span(self, head: float) -> tuple[float, float]:
-        x = head + self.contact_x
-        return float(np.min(x)), float(np.max(x))
+        # min(head + x_i) is head + min(x_i) exactly: rounding is monotonic.
+        return head + self._contact_min, head + self._contact_max
 
     def _move_window(self, head: float) -> None:
         """Build the window around the train at ``head`` and carry the state over."""

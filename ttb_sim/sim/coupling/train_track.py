@@ -137,13 +137,15 @@ class ContactKernels:
     contact_newton: Callable[..., Any]
     rail_predictor: Callable[..., Any]
     rail_irregularity: Callable[..., Any]
+    contact_setup: Callable[..., Any]
+    rail_check: Callable[..., Any]
 
     @classmethod
     def load(cls) -> ContactKernels | None:
         """Return the compiled kernels, or None without numba (the numpy step runs)."""
         found = []
         for name in ('rail_rows', 'rail_values', 'rail_load', 'contact_newton',
-                     'rail_predictor', 'rail_irregularity'):
+                     'rail_predictor', 'rail_irregularity', 'contact_setup', 'rail_check'):
             kernel = kernels.compiled(name)
             if kernel is None:
                 return None
@@ -351,6 +353,8 @@ class TrainTrackCoupling(FreeDofState):
         self.p0 = p.static_wheel_load
         ellipse = ct.hertz_ellipse(self.p0, p.wheel_radius)
         self.creep0 = ct.creep_coefficients(ellipse.a, ellipse.b)
+        self._creep0 = np.array(self.creep0, dtype=float)
+        self._creep_exponents = np.array(ct.CREEP_LOAD_EXPONENTS, dtype=float)
         self.table: ContactGeometryTable | None = (
             contact_geometry_table() if cc.geometry == 'profiles' else None)
         self._tables = self._geometry_tables()
@@ -468,6 +472,7 @@ class TrainTrackCoupling(FreeDofState):
         self.a_inv = np.linalg.inv(eff)
         self.dw = self.h @ self.a_inv @ self.h.T
         self.ey = (self.a_inv @ self.h.T)[self._wheelset_y]
+        self._ey = np.ascontiguousarray(self.ey)
         self._speed = speed
 
     # -- static equilibrium -------------------------------------------------------------
@@ -569,8 +574,8 @@ class TrainTrackCoupling(FreeDofState):
         if self.table is None:
             return
         limit = float(self.table.lateral[-1])
-        beyond = np.abs(lateral) > limit
-        if np.any(beyond):
+        if float(np.abs(lateral).max()) > limit:
+            beyond = np.abs(lateral) > limit
             car, wheel = np.argwhere(beyond)[0]
             shift = lateral[car, wheel] * 1e3
             raise DivergenceError(
@@ -767,10 +772,11 @@ class TrainTrackCoupling(FreeDofState):
         """
         Take the step with the compiled kernels: the numpy step's formulas, in loops.
 
-        The rail rows, the local compliance, the Newton iteration of the contact
-        laws and the rail loads and responses run compiled
-        (:mod:`ttb_sim.sim.contact_kernels`); the train's small dense products and
-        the irregularity stay as in :meth:`_step_numpy`.
+        The rail rows, the local compliance, the irregularity, the step's constants
+        of the contact iteration, its Newton iteration, the rail loads and the
+        check of the rail's response run compiled
+        (:mod:`ttb_sim.sim.contact_kernels`); the train's small products stay numpy's,
+        as in :meth:`_step_numpy`.
 
         With the local K^-1 columns (:attr:`influence_hops`) the step solves the
         track once: the rail motion of the predictor under the wheels comes from
@@ -833,18 +839,16 @@ class TrainTrackCoupling(FreeDofState):
         q_star = rhs_t @ self.a_inv.T
         w0 = q_star @ self.h.T
         wv0 = a1 * w0 + qh_v @ self.h.T
-        normal = np.maximum(self.force[..., 2], 0.0)
-        f11, f22, f23, f33 = (np.ascontiguousarray(np.broadcast_to(f, (n, 8))) for f in
-                              ct.scaled_creep_coefficients(self.creep0, self.p0, normal))
-        r0p = np.zeros((n, 8, COMPONENTS))
-        r0p[..., :3] = r_star
-        rv0 = np.zeros((n, 8, COMPONENTS))
-        rv0[..., :3] = a1 * r_star + r_hist + speed * rs_star
-        rvel = a1 * dr + speed * ds
+        creep = self._buffer('creep', (4, n, 8))
+        r0p = self._buffer('r0p', (n, 8, COMPONENTS))
+        rv0 = self._buffer('rv0', (n, 8, COMPONENTS))
+        rvel = self._buffer('rvel', (n, 8, 3, 3))
+        y_star = self._buffer('y_star', (n, 8))
+        k.contact_setup(self.force, self._creep0, self._creep_exponents, float(self.p0), r_star,
+                        rs_star, r_hist, dr, ds, a1, float(speed), q_star, self._wheelset_y,
+                        creep, r0p, rv0, rvel, y_star)
         offset = self._rail_offset.copy()
         slope_offset = self._slope_offset.copy()
-        y_star = np.ascontiguousarray(q_star[:, self._wheelset_y])
-        ey = np.ascontiguousarray(self.ey)
         lateral, radius_table, angle_table, rise, roll = self._tables
         g = self.force.reshape(n, m).copy()
         y_rel = np.empty((n, 8))
@@ -852,21 +856,17 @@ class TrainTrackCoupling(FreeDofState):
         eps = np.empty((n, 8))
         load = self._buffer('load', (n_free + 1,))
         r_exact = np.empty((n, 8, 3))
-        rs_exact = np.empty((n, 8, 3))
-        slope_mismatch = np.zeros((n, 8, 3))
+        mismatch = self._buffer('mismatch', (n, 8, 3))
+        slope_mismatch = self._buffer('slope_mismatch', (n, 8, 3))
         total_iter = 0
         for _outer in range(self.max_iter):
-            rp = (r0p + offset).reshape(n, m)
-            rvp = rv0 + a1 * offset
-            if single:
-                rvp[..., :3] += speed * slope_offset
-            rvp = rvp.reshape(n, m)
             iterations, change = k.contact_newton(
-                g, w0, wv0, rp, rvp, self.dw, dr, rvel, ey, y_star, irr_y, irr_z, irr_dy,
-                self.side, f11, f22, f23, f33, lateral, radius_table, angle_table, rise, roll,
-                float(self.params.contact_semi_distance), float(self.contact.conicity),
-                float(self.r0), self.g_hertz, float(self.friction), a1, float(speed),
-                GEOMETRY_STEP, float(self.tol), int(self.max_iter), y_rel, delta, eps)
+                g, w0, wv0, r0p, rv0, offset, slope_offset, self.dw, dr, rvel, self._ey,
+                y_star, irr_y, irr_z, irr_dy, self.side, creep, lateral, radius_table,
+                angle_table, rise, roll, float(self.params.contact_semi_distance),
+                float(self.contact.conicity), float(self.r0), self.g_hertz,
+                float(self.friction), a1, float(speed), GEOMETRY_STEP, float(self.tol),
+                int(self.max_iter), y_rel, delta, eps)
             total_iter += iterations
             if not change < self.tol:
                 raise DivergenceError(f'contact iteration did not converge in {self.max_iter} '
@@ -877,16 +877,10 @@ class TrainTrackCoupling(FreeDofState):
                 u_new = nm.solve(rhs + load[:n_free])
             else:
                 u_new = u_star + nm.solve(load[:n_free])
-            k.rail_values(rows, u_new, dofs, r_exact)
-            gx = g.reshape(n, 8, COMPONENTS)[..., :3]
-            r_model = rp.reshape(n, 8, COMPONENTS)[..., :3] - np.einsum('cwij,cwj->cwi', dr, gx)
-            mismatch = r_exact - r_model
-            if single:
-                k.rail_values(slope, u_new, dofs, rs_exact)
-                slope_mismatch = rs_exact - (rs_star + slope_offset
-                                             - np.einsum('cwij,cwj->cwi', ds, gx))
             # The single-solve step checks every component: its predictor is local too.
-            if np.max(np.abs(mismatch if single else mismatch[..., 2])) <= self.tol:
+            worst = k.rail_check(rows, slope, u_new, dofs, r0p, offset, dr, ds, g, rs_star,
+                                 slope_offset, single, r_exact, mismatch, slope_mismatch)
+            if worst <= self.tol:
                 break
             offset[..., :3] += mismatch
             slope_offset += slope_mismatch
