@@ -280,8 +280,10 @@ def contact_setup(force: np.ndarray, creep0: np.ndarray, exponents: np.ndarray, 
     force : numpy.ndarray
         (n, 8, 4) the last step's contact forces (their Fz scales the creep coefficients).
     creep0, exponents : numpy.ndarray
-        (4,) Kalker's f11, f22, f23, f33 at the reference load ``p0`` (N) and the
-        exponents of their load scaling (:func:`scaled_creep_coefficients`).
+        (4,) Kalker's f11, f22, f23, f33 at the reference load and the exponents
+        of their load scaling (:func:`scaled_creep_coefficients`).
+    p0 : float
+        The reference load (N).
     r_star, rs_star, r_hist : numpy.ndarray
         (n, 8, 3) rail-head motion and slope of the predictor under each wheel, and
         the rail rows applied to the velocity history.
@@ -290,8 +292,9 @@ def contact_setup(force: np.ndarray, creep0: np.ndarray, exponents: np.ndarray, 
     a1, speed : float
         2 / dt (1/s) and the train speed (m/s).
     q_star : numpy.ndarray
-        (n, 42) the cars' predictor; ``wheelset_y`` (8,) the DOF of each wheel's
-        wheelset lateral displacement.
+        (n, 42) the cars' predictor.
+    wheelset_y : numpy.ndarray
+        (8,) the car DOF of each wheel's wheelset lateral displacement.
     creep : numpy.ndarray
         Out, (4, n, 8): f11, f22, f23, f33 of every wheel.
     r0p, rv0 : numpy.ndarray
@@ -333,9 +336,11 @@ def rail_check(rows: np.ndarray, slope: np.ndarray, u: np.ndarray, dofs: np.ndar
     Parameters
     ----------
     rows, slope : numpy.ndarray
-        (n, 8, 3, 12) rail-head rows and slopes; ``dofs`` (n, 8, 12) their DOFs.
+        (n, 8, 3, 12) rail-head rows and slopes.
     u : numpy.ndarray
         (n_free,) the track's end-of-step displacement.
+    dofs : numpy.ndarray
+        (n, 8, 12) the extended free DOFs of the rows (n_free: the ground slot).
     r0p, offset : numpy.ndarray
         (n, 8, 4) rail-head motion without contact force and the offset of the model.
     dr, ds : numpy.ndarray
