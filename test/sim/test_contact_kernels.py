@@ -151,7 +151,6 @@ def test_step_setup_and_rail_check_are_the_numpy_formulas():
     n = 2
     force = rng.normal(size=(n, 8, 4)) * 1e5
     creep0 = rng.uniform(1e6, 1e7, size=4)
-    exponents = np.array(train_track.ct.CREEP_LOAD_EXPONENTS)
     r_star, rs_star, r_hist = (rng.normal(size=(n, 8, 3)) for _ in range(3))
     dr, ds = rng.normal(size=(n, 8, 3, 3)), rng.normal(size=(n, 8, 3, 3))
     q_star = rng.normal(size=(n, 42))
@@ -159,9 +158,8 @@ def test_step_setup_and_rail_check_are_the_numpy_formulas():
     a1, speed, p0 = 2e4, 80.0, 7e4
     creep, r0p, rv0 = np.empty((4, n, 8)), np.empty((n, 8, 4)), np.empty((n, 8, 4))
     rvel, y_star = np.empty((n, 8, 3, 3)), np.empty((n, 8))
-    kernels.compiled('contact_setup')(force, creep0, exponents, p0, r_star, rs_star, r_hist,
-                                      dr, ds, a1, speed, q_star, wheelset_y, creep, r0p, rv0,
-                                      rvel, y_star)
+    kernels.compiled('contact_setup')(force, creep0, p0, r_star, rs_star, r_hist, dr, ds, a1,
+                                      speed, q_star, wheelset_y, creep, r0p, rv0, rvel, y_star)
     expected = train_track.ct.scaled_creep_coefficients(tuple(creep0), p0, force[..., 2])
     np.testing.assert_allclose(creep, np.array(expected), rtol=1e-15, atol=0)
     np.testing.assert_array_equal(r0p[..., :3], r_star)

@@ -48,9 +48,12 @@ import math
 
 import numpy as np
 
+from ttb_sim.model.wheel_rail.creep import CREEP_LOAD_EXPONENTS
+
 COMPONENTS = 4
 """Contact force components per wheel: Fx, Fy, Fz, Mz."""
-HELPERS = ('_hermite', '_interp', '_interval', '_solve_in_place', 'quintic')
+HELPERS = ('_hermite', '_interp', '_interval', '_solve_in_place', '_wheel_force_products',
+           'quintic')
 """Functions the kernels call: :func:`ttb_sim.sim.kernels.compiled` compiles them first."""
 prange = range
 """The cars' loop of :func:`rail_predictor`; numba's ``prange`` once it is compiled
@@ -266,8 +269,8 @@ def rail_predictor(element: np.ndarray, side: np.ndarray, start_l: np.ndarray,
                 rs_out[c, k, i] = acc_s
 
 
-def contact_setup(force: np.ndarray, creep0: np.ndarray, exponents: np.ndarray, p0: float,
-                  r_star: np.ndarray, rs_star: np.ndarray, r_hist: np.ndarray,
+def contact_setup(force: np.ndarray, creep0: np.ndarray, p0: float, r_star: np.ndarray,
+                  rs_star: np.ndarray, r_hist: np.ndarray,
                   dr: np.ndarray, ds: np.ndarray, a1: float, speed: float,
                   q_star: np.ndarray, wheelset_y: np.ndarray, creep: np.ndarray,
                   r0p: np.ndarray, rv0: np.ndarray, rvel: np.ndarray,
@@ -279,9 +282,9 @@ def contact_setup(force: np.ndarray, creep0: np.ndarray, exponents: np.ndarray, 
     ----------
     force : numpy.ndarray
         (n, 8, 4) the last step's contact forces (their Fz scales the creep coefficients).
-    creep0, exponents : numpy.ndarray
-        (4,) Kalker's f11, f22, f23, f33 at the reference load and the exponents
-        of their load scaling (:func:`scaled_creep_coefficients`).
+    creep0 : numpy.ndarray
+        (4,) Kalker's f11, f22, f23, f33 at the reference load, scaled with the
+        load by CREEP_LOAD_EXPONENTS (:func:`scaled_creep_coefficients`).
     p0 : float
         The reference load (N).
     r_star, rs_star, r_hist : numpy.ndarray
@@ -311,7 +314,7 @@ def contact_setup(force: np.ndarray, creep0: np.ndarray, exponents: np.ndarray, 
         for k in range(n_wheels):
             ratio = max(force[c, k, 2], 0.0) / p0
             for t in range(4):
-                creep[t, c, k] = creep0[t] * ratio ** exponents[t]
+                creep[t, c, k] = creep0[t] * ratio ** CREEP_LOAD_EXPONENTS[t]
             y_star[c, k] = q_star[c, wheelset_y[k]]
             for i in range(3):
                 r0p[c, k, i] = r_star[c, k, i]
@@ -320,6 +323,18 @@ def contact_setup(force: np.ndarray, creep0: np.ndarray, exponents: np.ndarray, 
                     rvel[c, k, i, j] = a1 * dr[c, k, i, j] + speed * ds[c, k, i, j]
             r0p[c, k, 3] = 0.0
             rv0[c, k, 3] = 0.0
+
+
+def _wheel_force_products(a: np.ndarray, b: np.ndarray, g: np.ndarray, c: int, k: int,
+                          i: int) -> tuple[float, float]:
+    """Return row i of wheel k's 3 x 3 blocks a and b (car c) times its (Fx, Fy, Fz) in g."""
+    o = COMPONENTS * k
+    acc_a = 0.0
+    acc_b = 0.0
+    for j in range(3):
+        acc_a += a[c, k, i, j] * g[c, o + j]
+        acc_b += b[c, k, i, j] * g[c, o + j]
+    return acc_a, acc_b
 
 
 def rail_check(rows: np.ndarray, slope: np.ndarray, u: np.ndarray, dofs: np.ndarray,
@@ -367,7 +382,6 @@ def rail_check(rows: np.ndarray, slope: np.ndarray, u: np.ndarray, dofs: np.ndar
     worst = 0.0
     for c in range(n_cars):
         for k in range(n_wheels):
-            o = COMPONENTS * k
             for i in range(3):
                 acc = 0.0
                 acc_s = 0.0
@@ -376,11 +390,7 @@ def rail_check(rows: np.ndarray, slope: np.ndarray, u: np.ndarray, dofs: np.ndar
                     if d < size:
                         acc += rows[c, k, i, j] * u[d]
                         acc_s += slope[c, k, i, j] * u[d]
-                model = 0.0
-                model_s = 0.0
-                for j in range(3):
-                    model += dr[c, k, i, j] * g[c, o + j]
-                    model_s += ds[c, k, i, j] * g[c, o + j]
+                model, model_s = _wheel_force_products(dr, ds, g, c, k, i)
                 r_exact[c, k, i] = acc
                 miss = acc - ((r0p[c, k, i] + offset[c, k, i]) - model)
                 mismatch[c, k, i] = miss
@@ -579,11 +589,7 @@ def contact_newton(g: np.ndarray, w0: np.ndarray, wv0: np.ndarray, r0p: np.ndarr
             for k in range(n_wheels):
                 o = COMPONENTS * k
                 for i in range(3):
-                    acc = 0.0
-                    acc_v = 0.0
-                    for j in range(3):
-                        acc += dr[c, k, i, j] * g[c, o + j]
-                        acc_v += rvel[c, k, i, j] * g[c, o + j]
+                    acc, acc_v = _wheel_force_products(dr, rvel, g, c, k, i)
                     rp = r0p[c, k, i] + offset[c, k, i]
                     rvp = rv0[c, k, i] + a1 * offset[c, k, i] + speed * slope_offset[c, k, i]
                     r[o + i] = rp - acc

@@ -354,7 +354,6 @@ class TrainTrackCoupling(FreeDofState):
         ellipse = ct.hertz_ellipse(self.p0, p.wheel_radius)
         self.creep0 = ct.creep_coefficients(ellipse.a, ellipse.b)
         self._creep0 = np.array(self.creep0, dtype=float)
-        self._creep_exponents = np.array(ct.CREEP_LOAD_EXPONENTS, dtype=float)
         self.table: ContactGeometryTable | None = (
             contact_geometry_table() if cc.geometry == 'profiles' else None)
         self._tables = self._geometry_tables()
@@ -472,7 +471,6 @@ class TrainTrackCoupling(FreeDofState):
         self.a_inv = np.linalg.inv(eff)
         self.dw = self.h @ self.a_inv @ self.h.T
         self.ey = (self.a_inv @ self.h.T)[self._wheelset_y]
-        self._ey = np.ascontiguousarray(self.ey)
         self._speed = speed
 
     # -- static equilibrium -------------------------------------------------------------
@@ -574,8 +572,8 @@ class TrainTrackCoupling(FreeDofState):
         if self.table is None:
             return
         limit = float(self.table.lateral[-1])
-        if float(np.abs(lateral).max()) > limit:
-            beyond = np.abs(lateral) > limit
+        beyond = np.abs(lateral) > limit
+        if np.any(beyond):
             car, wheel = np.argwhere(beyond)[0]
             shift = lateral[car, wheel] * 1e3
             raise DivergenceError(
@@ -819,9 +817,9 @@ class TrainTrackCoupling(FreeDofState):
         zero = self._zero if self._zero.shape[0] == n_free else np.zeros(n_free)
         h_v, h_a = nm.history(self.u, self.v, self.a)
         rhs = nm.effective_load(zero, h_v, h_a)
-        r_star = np.empty((n, 8, 3))
-        rs_star = np.empty((n, 8, 3))
-        r_hist = np.empty((n, 8, 3))
+        r_star = self._buffer('r_star', (n, 8, 3))
+        rs_star = self._buffer('rs_star', (n, 8, 3))
+        r_hist = self._buffer('r_hist', (n, 8, 3))
         if single:
             infl_l, infl_r = self.compliance.influence
             k.rail_predictor(element, self.side, *infl_l, *infl_r, rows, slope, rhs, r_star,
@@ -844,9 +842,9 @@ class TrainTrackCoupling(FreeDofState):
         rv0 = self._buffer('rv0', (n, 8, COMPONENTS))
         rvel = self._buffer('rvel', (n, 8, 3, 3))
         y_star = self._buffer('y_star', (n, 8))
-        k.contact_setup(self.force, self._creep0, self._creep_exponents, float(self.p0), r_star,
-                        rs_star, r_hist, dr, ds, a1, float(speed), q_star, self._wheelset_y,
-                        creep, r0p, rv0, rvel, y_star)
+        k.contact_setup(self.force, self._creep0, float(self.p0), r_star, rs_star, r_hist, dr,
+                        ds, a1, float(speed), q_star, self._wheelset_y, creep, r0p, rv0, rvel,
+                        y_star)
         offset = self._rail_offset.copy()
         slope_offset = self._slope_offset.copy()
         lateral, radius_table, angle_table, rise, roll = self._tables
@@ -855,13 +853,13 @@ class TrainTrackCoupling(FreeDofState):
         delta = np.empty((n, 8))
         eps = np.empty((n, 8))
         load = self._buffer('load', (n_free + 1,))
-        r_exact = np.empty((n, 8, 3))
+        r_exact = self._buffer('r_exact', (n, 8, 3))
         mismatch = self._buffer('mismatch', (n, 8, 3))
         slope_mismatch = self._buffer('slope_mismatch', (n, 8, 3))
         total_iter = 0
         for _outer in range(self.max_iter):
             iterations, change = k.contact_newton(
-                g, w0, wv0, r0p, rv0, offset, slope_offset, self.dw, dr, rvel, self._ey,
+                g, w0, wv0, r0p, rv0, offset, slope_offset, self.dw, dr, rvel, self.ey,
                 y_star, irr_y, irr_z, irr_dy, self.side, creep, lateral, radius_table,
                 angle_table, rise, roll, float(self.params.contact_semi_distance),
                 float(self.contact.conicity), float(self.r0), self.g_hertz,
