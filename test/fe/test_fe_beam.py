@@ -17,7 +17,10 @@ Beam element checks against closed forms.
 
 References: simply supported beam frequencies f_j = j^2 pi/(2 L^2) sqrt(EI/m)
 (tolerance 1e-4 with 16 elements); tip deflection of a cantilever P L^3/(3 EI)
-(exact for cubic Hermite elements, 1e-10); rotation invariance of the element.
+(exact for cubic Hermite elements, 1e-10); rotation invariance of the element; the
+interior flexibility of an element under a point load at a head point against the same
+element clamped and split at the load (nodal values exact, 1e-9) and against the closed
+form of a clamped beam P a^3 b^3 / (3 EI L^3).
 """
 
 import math
@@ -26,7 +29,8 @@ import numpy as np
 import pytest
 import scipy.linalg as la
 from ttb_sim.fe.assembly import assemble, link_kinematics
-from ttb_sim.fe.beam import BeamSection, global_matrices, local_matrices, vertical_row
+from ttb_sim.fe.beam import (BeamSection, global_matrices, interior_compliance, local_matrices,
+                             offset_rows, vertical_row)
 
 
 def _section(n, ea=2e9, gj=3e8, ei_y=5e8, ei_z=7e8, m=100.0, ix=20.0):
@@ -110,3 +114,26 @@ def test_link_kinematics_rigid_arm():
     q[3] = 0.01  # twist of node a about x
     # A point 2 m to the left rises by 2 * 0.01 when the section twists by +0.01.
     assert np.allclose(g @ q, [0.0, 0.0, 0.02])
+
+
+@pytest.mark.parametrize('xi', [0.0, 0.13, 0.5, 0.71, 1.0])
+def test_interior_compliance_is_the_clamped_element_split_at_the_load(xi):
+    # The element clamped at both nodes and cut at the load point into two exact
+    # elements: the cut node's motion under the head forces is the interior flexibility.
+    length, height = 0.315, 0.088
+    sec = {'ea': 1.6e9, 'gj': 1.958e5, 'ei_y': 6.6e6, 'ei_z': 1.08e6}
+    got = interior_compliance(np.array([xi]), np.array([length]), *(
+        np.array([v]) for v in sec.values()), height)[0]
+    head = offset_rows(np.eye(6)[None], np.array([0.0, 0.0, height]))[0]     # (3, 6)
+    if xi in (0.0, 1.0):
+        np.testing.assert_array_equal(got, 0.0)
+        return
+    a = xi * length
+    ends = np.array([[0.0, 0.0, 0.0], [a, 0.0, 0.0], [length, 0.0, 0.0]])
+    section = BeamSection(*(np.full(2, v) for v in (*sec.values(), 60.0, 1.0)))
+    k, _, _ = global_matrices(ends[:2], ends[1:], section)
+    stiffness = k[0, 6:, 6:] + k[1, :6, :6]           # the cut node, both ends fixed
+    want = head @ np.linalg.solve(stiffness, head.T)
+    np.testing.assert_allclose(got, want, rtol=1e-9, atol=1e-9 * np.abs(want).max())
+    b = length - a
+    assert got[2, 2] == pytest.approx(a**3 * b**3 / (3 * sec['ei_y'] * length**3), rel=1e-12)

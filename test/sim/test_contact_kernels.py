@@ -20,6 +20,7 @@ import numpy as np
 import pytest
 
 from ttb_sim.config import load_scenario
+import ttb_sim.model.wheel_rail as ct
 from ttb_sim.sim import kernels
 from ttb_sim.sim.coupling import train_track
 from ttb_sim.sim.simulation import Simulation
@@ -90,16 +91,21 @@ def test_local_columns_give_the_rail_motion_of_the_predictor_solve():
         rows, slope = np.zeros((n, 8, 3, 12)), np.zeros((n, 8, 3, 12))
         dofs, element = np.zeros((n, 8, 12), dtype=np.intp), np.zeros((n, 8), dtype=np.intp)
         dr, ds = np.zeros((n, 8, 3, 3)), np.zeros((n, 8, 3, 3))
+        interior = np.zeros((n, 8, 3, 3))
         left, right = tt.rails
+        sec_l, sec_r = tt._rail_sections
         assert k.rail_rows(x, tt.side, left.start, left.length, tt.rail_dofs[0],
-                           tt.compliance.blocks[0], right.start, right.length,
-                           tt.rail_dofs[1], tt.compliance.blocks[1], float(tt.head_arm[2]),
-                           rows, slope, dofs, dr, ds, element) == -1
+                           tt.compliance.blocks[0], sec_l, right.start, right.length,
+                           tt.rail_dofs[1], tt.compliance.blocks[1], sec_r,
+                           float(tt.head_arm[2]), rows, slope, dofs, dr, ds, interior,
+                           element) == -1
         # The numpy rows of the same wheels.
-        rows_np, slope_np, dofs_np, _ = tt._rail_rows(x)
+        rows_np, slope_np, dofs_np, _, interior_np = tt._rail_rows(x)
         np.testing.assert_allclose(rows, rows_np, rtol=0, atol=1e-12)
         np.testing.assert_allclose(slope, slope_np, rtol=0, atol=1e-12)
         assert np.array_equal(dofs, dofs_np)
+        assert np.max(interior[..., 1, 1]) > 0.0          # wheels inside their elements
+        np.testing.assert_allclose(interior, interior_np, rtol=1e-13, atol=0)
         nm = tt.nm
         h_v, h_a = nm.history(tt.u, tt.v, tt.a)
         rhs = nm.effective_load(np.zeros(tt.n_free), h_v, h_a)
@@ -123,20 +129,24 @@ def test_single_solve_step_solves_once_and_meets_the_contact_tolerance(monkeypat
     One track solve per step; the passage equals the numpy step's to the contact tolerance.
 
     Both steps stop when the rail under the wheels agrees with the local model to
-    contact.tolerance, so they differ by what that tolerance lets through; a
-    hundred times tighter, they agree a good ten times better (measured 3.7e-5
-    and 1.3e-6 relative on the forces).
+    contact.tolerance, so their forces differ by at most about what that
+    tolerance is worth through the contact stiffness, k_H tol (measured 6.1e-6
+    of the largest force, the bound 1.9e-5); a hundred times tighter they agree
+    better (1.4e-6: what remains is the rail slope of the predictor, which the
+    single-solve step takes from the local K^-1 columns and does not iterate).
     """
-    _, f_single, m_single, solves = passage(0.06)
+    sim, f_single, m_single, solves = passage(0.06)
     assert np.mean(solves) < 1.05
     tight = [('contact.tolerance', 1e-11)]
     _, f_tight, m_tight, _ = passage(0.06, tight)
     monkeypatch.setattr(kernels, 'ENABLED', False)
     _, f_numpy, m_numpy, solves_numpy = passage(0.06, tight)
     assert min(solves_numpy) == 2
-    assert relative(f_tight, f_numpy) < 1e-5
+    tt = sim.coupling
+    worth = ct.linearised_stiffness(tt.p0, tt.g_hertz) * tt.tol / np.max(np.abs(f_numpy))
+    assert relative(f_single, f_numpy) < worth
+    assert relative(f_tight, f_numpy) < 0.5 * relative(f_single, f_numpy)
     assert relative(m_tight[..., 2], m_numpy[..., 2]) < 1e-6
-    assert relative(f_tight, f_numpy) < 0.2 * relative(f_single, f_numpy)
 
 
 def test_step_setup_and_rail_check_are_the_numpy_formulas():
@@ -151,20 +161,22 @@ def test_step_setup_and_rail_check_are_the_numpy_formulas():
     n = 2
     force = rng.normal(size=(n, 8, 4)) * 1e5
     creep0 = rng.uniform(1e6, 1e7, size=4)
-    r_star, rs_star, r_hist = (rng.normal(size=(n, 8, 3)) for _ in range(3))
+    r_star, rs_star, r_hist, interior_r, interior_v = (
+        rng.normal(size=(n, 8, 3)) for _ in range(5))
     dr, ds = rng.normal(size=(n, 8, 3, 3)), rng.normal(size=(n, 8, 3, 3))
     q_star = rng.normal(size=(n, 42))
     wheelset_y = 6 * np.repeat(np.arange(3, 7), 2) + 1
     a1, speed, p0 = 2e4, 80.0, 7e4
     creep, r0p, rv0 = np.empty((4, n, 8)), np.empty((n, 8, 4)), np.empty((n, 8, 4))
     rvel, y_star = np.empty((n, 8, 3, 3)), np.empty((n, 8))
-    kernels.compiled('contact_setup')(force, creep0, p0, r_star, rs_star, r_hist, dr, ds, a1,
-                                      speed, q_star, wheelset_y, creep, r0p, rv0, rvel, y_star)
+    kernels.compiled('contact_setup')(force, creep0, p0, r_star, rs_star, r_hist, interior_r,
+                                      interior_v, dr, ds, a1, speed, q_star, wheelset_y, creep,
+                                      r0p, rv0, rvel, y_star)
     expected = train_track.ct.scaled_creep_coefficients(tuple(creep0), p0, force[..., 2])
     np.testing.assert_allclose(creep, np.array(expected), rtol=1e-15, atol=0)
     np.testing.assert_array_equal(r0p[..., :3], r_star)
-    np.testing.assert_allclose(rv0[..., :3], a1 * r_star + r_hist + speed * rs_star,
-                               rtol=1e-15, atol=1e-15 * a1)
+    np.testing.assert_allclose(rv0[..., :3], a1 * r_star + r_hist + speed * rs_star
+                               - a1 * interior_r - interior_v, rtol=1e-15, atol=1e-14 * a1)
     assert not np.any(r0p[..., 3]) and not np.any(rv0[..., 3])
     np.testing.assert_allclose(rvel, a1 * dr + speed * ds, rtol=1e-15, atol=1e-15 * a1)
     np.testing.assert_array_equal(y_star, q_star[:, wheelset_y])

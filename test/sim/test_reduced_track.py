@@ -191,7 +191,7 @@ def test_window_predicts_its_rail_motion_from_the_full_models_columns(monkeypatc
             continue
         assert tt.compliance.influence
         head = sim.scenario.train.start_position + sim.speed * i * sim.output_every * sim.dt
-        rows, slope, dofs, _ = tt._rail_rows(head + tt.contact_x)
+        rows, slope, dofs, _, _ = tt._rail_rows(head + tt.contact_x)
         element = np.searchsorted(tt.rails[0].start, head + tt.contact_x, side='right') - 1
         nm = tt.nm
         rhs = nm.effective_load(np.zeros(tt.n_free), *nm.history(tt.u, tt.v, tt.a)).copy()

@@ -125,9 +125,11 @@ def test_contact_forces_satisfy_hertz_on_the_exact_track_response():
     for _ in sim.frames():
         pass
     x = sim.scenario.train.start_position + sim.speed * sim.n_steps * sim.dt + tt.contact_x
-    rows, _, dofs, _ = tt._rail_rows(x)
+    rows, _, dofs, _, interior = tt._rail_rows(x)
     ue = np.append(tt.u, 0.0)
-    rail_z = np.einsum('cwj,cwj->cw', rows[..., 2, :], ue[dofs])
+    # The rail head: its element's nodes' interpolation and its interior deflection.
+    rail_z = (np.einsum('cwj,cwj->cw', rows[..., 2, :], ue[dofs])
+              - np.einsum('cwj,cwj->cw', interior[..., 2, :], tt.force[..., :3]))
     irr_z, _, _ = tt._irregularity(x)
     wheel_z = (tt.q @ tt.h.T).reshape(tt.n_cars, 8, 4)[..., 2]
     y_rel = tt.q[:, tt._wheelset_y] - tt._rail_y - tt._irregularity(x)[1]

@@ -301,3 +301,58 @@ def offset_rows(fields: np.ndarray, arm: np.ndarray) -> np.ndarray:
     out[..., 1, :] += q[..., 2, :] * r[..., 0, None] - q[..., 0, :] * r[..., 2, None]
     out[..., 2, :] += q[..., 0, :] * r[..., 1, None] - q[..., 1, :] * r[..., 0, None]
     return out
+
+
+def interior_compliance(xi: np.ndarray, length: np.ndarray, ea: np.ndarray, gj: np.ndarray,
+                        ei_y: np.ndarray, ei_z: np.ndarray, height: float) -> np.ndarray:
+    """
+    Return the flexibility of an element's interior under a point load at a head point.
+
+    The element interpolates its nodes' motion with the shape functions above,
+    which are exact for a beam loaded only at its nodes. Under a point load
+    inside the element the beam also deflects as the element clamped at both
+    nodes would (the particular solution, zero at the nodes): with the load at
+    a = xi L from the first node and b = L - a from the second,
+
+    - deflection under a transverse force: a^3 b^3 / (3 EI L^3),
+    - rotation under a moment: a b (a^2 - a b + b^2) / (EI L^3),
+    - rotation under a force (and deflection under a moment): (a - b) a^2 b^2 / (2 EI L^3)
+      (the slope of the deflection, in the sign of theta_y = -w'),
+    - axial displacement and twist: a b / (EA L), a b / (GJ L).
+
+    Nodal displacements of Euler beam elements are exact, so the static
+    motion of a point load's own point is the interpolation plus this, on any
+    mesh. For a point at ``height`` above the axis (the rail head; force
+    (Fx, Fy, Fz) there is a force and a moment (-h Fy, h Fx, 0) at the axis) the
+    flexibility is A G A^T with A the map of the axis motion to the point's.
+
+    Parameters
+    ----------
+    xi, length : numpy.ndarray
+        Local coordinate of the load and element length (m), shape (n,).
+    ea, gj, ei_y, ei_z : numpy.ndarray
+        The element's section (:class:`BeamSection`), shape (n,).
+    height : float
+        Height of the loaded point above the axis (m).
+
+    Returns
+    -------
+    numpy.ndarray
+        (n, 3, 3): x, y, z motion of the point per unit force along x, y, z (m/N).
+
+    """
+    xi = np.asarray(xi, dtype=float)
+    length = np.asarray(length, dtype=float)
+    a = xi * length
+    b = (1.0 - xi) * length
+    ab = a * b
+    cube = length**3
+    deflection = ab**3 / (3.0 * cube)
+    rotation = ab * (a * a - ab + b * b) / cube
+    coupling = (a - b) * ab * ab / (2.0 * cube)
+    out = np.zeros(xi.shape + (3, 3))
+    out[..., 0, 0] = ab / (length * ea) + height**2 * rotation / ei_y
+    out[..., 0, 2] = out[..., 2, 0] = height * coupling / ei_y
+    out[..., 1, 1] = deflection / ei_z + height**2 * ab / (length * gj)
+    out[..., 2, 2] = deflection / ei_y
+    return out

@@ -148,6 +148,10 @@ class BeamLine:
         Height of the beam axis (m).
     y : float
         Lateral position of the beam axis (m).
+    section : BeamSection or None
+        Section of each element (the rails carry theirs: a wheel load inside an
+        element deflects it beyond the nodes' interpolation,
+        :func:`ttb_sim.fe.beam.interior_compliance`).
 
     """
 
@@ -156,6 +160,7 @@ class BeamLine:
     dofs: np.ndarray
     z: float
     y: float = 0.0
+    section: BeamSection | None = None
 
     @property
     def end(self) -> float:
@@ -415,14 +420,15 @@ def build_track(track: TrackParameters, bridge_length: float, train_length: floa
     section = BeamSection(*(np.concatenate([getattr(sec, f) for sec in sections])
                             for f in ('ea', 'gj', 'ei_y', 'ei_z', 'mass', 'inertia_x')))
 
-    def line(ids: np.ndarray, pairs: np.ndarray, y: float, z: float) -> BeamLine:
+    def line(ids: np.ndarray, pairs: np.ndarray, y: float, z: float,
+             sec: BeamSection | None = None) -> BeamLine:
         start = coords_all[pairs[:, 0] - first_node, 0]
         length = coords_all[pairs[:, 1] - first_node, 0] - start
         dofs = (pairs[:, :, None] * NODE_DOFS + np.arange(NODE_DOFS)).reshape(-1, 12)
-        return BeamLine(start, length, dofs, z, y)
+        return BeamLine(start, length, dofs, z, y, sec)
 
-    rails = (line(rail_ids[0], conn[0], track.rail_semi_spacing, z_rail),
-             line(rail_ids[1], conn[1], -track.rail_semi_spacing, z_rail))
+    rails = (line(rail_ids[0], conn[0], track.rail_semi_spacing, z_rail, sections[0]),
+             line(rail_ids[1], conn[1], -track.rail_semi_spacing, z_rail, sections[1]))
     slab = line(slab_ids, conn[2], 0.0, z_slab)
     base = line(base_ids, conn[3], 0.0, z_base)
 

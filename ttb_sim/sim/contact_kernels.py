@@ -23,9 +23,10 @@ round-off (tested). Each function is written as plain loops for numba; run
 uncompiled they are correct but slow.
 
 * :func:`rail_rows`: the element of each rail under each wheel, the rail-head
-  rows and slopes (cubic Hermite beam, the rail head above the axis) and the
+  rows and slopes (cubic Hermite beam, the rail head above the axis), the
   local compliance of the rail under the wheel (rows B rows^T, B the element's
-  block of the inverse effective track matrix).
+  block of the inverse effective track matrix) and the element's interior
+  flexibility under the wheel (:func:`ttb_sim.fe.beam.interior_compliance`).
 * :func:`rail_values`: rail-head motion under the wheels from a track vector.
 * :func:`rail_predictor`: the same of K^-1 rhs from the local columns of K^-1
   (the single-solve step).
@@ -52,8 +53,8 @@ from ttb_sim.model.wheel_rail.creep import CREEP_LOAD_EXPONENTS
 
 COMPONENTS = 4
 """Contact force components per wheel: Fx, Fy, Fz, Mz."""
-HELPERS = ('_hermite', '_interp', '_interval', '_solve_in_place', '_wheel_force_products',
-           'quintic')
+HELPERS = ('_hermite', '_interior', '_interp', '_interval', '_solve_in_place',
+           '_wheel_force_products', 'quintic')
 """Functions the kernels call: :func:`ttb_sim.sim.kernels.compiled` compiles them first."""
 prange = range
 """The cars' loop of :func:`rail_predictor`; numba's ``prange`` once it is compiled
@@ -84,11 +85,31 @@ def _hermite(xi: float, length: float, derivative: int, out: np.ndarray) -> None
         out[3] = (-2 + 6 * xi) * length * scale
 
 
+def _interior(xi: float, length: float, section: np.ndarray, height: float,
+              out: np.ndarray) -> None:
+    """Interior flexibility of an element under a head load (beam.interior_compliance)."""
+    a = xi * length
+    b = (1.0 - xi) * length
+    ab = a * b
+    cube = length**3
+    deflection = ab**3 / (3.0 * cube)
+    rotation = ab * (a * a - ab + b * b) / cube
+    coupling = (a - b) * ab * ab / (2.0 * cube)
+    ea, gj, ei_y, ei_z = section[0], section[1], section[2], section[3]
+    out[:, :] = 0.0
+    out[0, 0] = ab / (length * ea) + height**2 * rotation / ei_y
+    out[0, 2] = height * coupling / ei_y
+    out[2, 0] = out[0, 2]
+    out[1, 1] = deflection / ei_z + height**2 * ab / (length * gj)
+    out[2, 2] = deflection / ei_y
+
+
 def rail_rows(x: np.ndarray, side: np.ndarray, start_l: np.ndarray, length_l: np.ndarray,
-              dofs_l: np.ndarray, blocks_l: np.ndarray, start_r: np.ndarray,
-              length_r: np.ndarray, dofs_r: np.ndarray, blocks_r: np.ndarray, arm: float,
+              dofs_l: np.ndarray, blocks_l: np.ndarray, section_l: np.ndarray,
+              start_r: np.ndarray, length_r: np.ndarray, dofs_r: np.ndarray,
+              blocks_r: np.ndarray, section_r: np.ndarray, arm: float,
               rows: np.ndarray, slope: np.ndarray, dofs: np.ndarray, dr: np.ndarray,
-              ds: np.ndarray, element: np.ndarray) -> int:
+              ds: np.ndarray, interior: np.ndarray, element: np.ndarray) -> int:
     """
     Fill the rail-head rows under every wheel and the local rail compliance.
 
@@ -96,10 +117,10 @@ def rail_rows(x: np.ndarray, side: np.ndarray, start_l: np.ndarray, length_l: np
     ----------
     x, side : numpy.ndarray
         (n, 8) wheel positions along the track (m) and sides (+1 left rail, -1 right).
-    start_l, length_l, dofs_l, blocks_l : numpy.ndarray
+    start_l, length_l, dofs_l, blocks_l, section_l : numpy.ndarray
         Left rail: element starts and lengths (m), extended free DOFs (n_el, 12),
-        compliance blocks (n_el, 12, 12).
-    start_r, length_r, dofs_r, blocks_r : numpy.ndarray
+        compliance blocks (n_el, 12, 12), sections (n_el, 4: EA, GJ, EI_y, EI_z).
+    start_r, length_r, dofs_r, blocks_r, section_r : numpy.ndarray
         The same for the right rail.
     arm : float
         Height of the rail head above the rail axis (m).
@@ -110,6 +131,8 @@ def rail_rows(x: np.ndarray, side: np.ndarray, start_l: np.ndarray, length_l: np
         Out, (n, 8, 12) extended free DOFs of those elements.
     dr, ds : numpy.ndarray
         Out, (n, 8, 3, 3): rows B rows^T and slope B rows^T.
+    interior : numpy.ndarray
+        Out, (n, 8, 3, 3): the element's interior flexibility under the wheel.
     element : numpy.ndarray
         Out, (n, 8) the rail element under each wheel.
 
@@ -130,8 +153,10 @@ def rail_rows(x: np.ndarray, side: np.ndarray, start_l: np.ndarray, length_l: np
         for k in range(n_wheels):
             if side[c, k] > 0:
                 start, length, rail_dofs, blocks = start_l, length_l, dofs_l, blocks_l
+                section = section_l
             else:
                 start, length, rail_dofs, blocks = start_r, length_r, dofs_r, blocks_r
+                section = section_r
             xx = x[c, k]
             e = np.searchsorted(start, xx, side='right') - 1
             e = min(max(e, 0), start.shape[0] - 1)
@@ -141,6 +166,7 @@ def rail_rows(x: np.ndarray, side: np.ndarray, start_l: np.ndarray, length_l: np
                 return c * n_wheels + k
             xi = min(max(local / el, 0.0), 1.0)
             element[c, k] = e
+            _interior(xi, el, section[e], arm, interior[c, k])
             for d in range(3):
                 _hermite(xi, el, d, h[d])
             for order in range(2):
@@ -270,8 +296,9 @@ def rail_predictor(element: np.ndarray, side: np.ndarray, start_l: np.ndarray,
 
 
 def contact_setup(force: np.ndarray, creep0: np.ndarray, p0: float, r_star: np.ndarray,
-                  rs_star: np.ndarray, r_hist: np.ndarray,
-                  dr: np.ndarray, ds: np.ndarray, a1: float, speed: float,
+                  rs_star: np.ndarray, r_hist: np.ndarray, interior_r: np.ndarray,
+                  interior_v: np.ndarray, dr: np.ndarray, ds: np.ndarray, a1: float,
+                  speed: float,
                   q_star: np.ndarray, wheelset_y: np.ndarray, creep: np.ndarray,
                   r0p: np.ndarray, rv0: np.ndarray, rvel: np.ndarray,
                   y_star: np.ndarray) -> None:
@@ -290,8 +317,13 @@ def contact_setup(force: np.ndarray, creep0: np.ndarray, p0: float, r_star: np.n
     r_star, rs_star, r_hist : numpy.ndarray
         (n, 8, 3) rail-head motion and slope of the predictor under each wheel, and
         the rail rows applied to the velocity history.
+    interior_r, interior_v : numpy.ndarray
+        (n, 8, 3) the last step's interior deflection of the rail element under each
+        wheel and its velocity (the trapezoidal rule continues it: its end-of-step
+        velocity is a1 (r_i - interior_r) - interior_v).
     dr, ds : numpy.ndarray
-        (n, 8, 3, 3) local rail compliance of the motion and the slope.
+        (n, 8, 3, 3) local rail compliance of the motion (the interior flexibility
+        included) and the slope.
     a1, speed : float
         2 / dt (1/s) and the train speed (m/s).
     q_star : numpy.ndarray
@@ -318,7 +350,8 @@ def contact_setup(force: np.ndarray, creep0: np.ndarray, p0: float, r_star: np.n
             y_star[c, k] = q_star[c, wheelset_y[k]]
             for i in range(3):
                 r0p[c, k, i] = r_star[c, k, i]
-                rv0[c, k, i] = a1 * r_star[c, k, i] + r_hist[c, k, i] + speed * rs_star[c, k, i]
+                rv0[c, k, i] = (a1 * r_star[c, k, i] + r_hist[c, k, i] + speed * rs_star[c, k, i]
+                                - a1 * interior_r[c, k, i] - interior_v[c, k, i])
                 for j in range(3):
                     rvel[c, k, i, j] = a1 * dr[c, k, i, j] + speed * ds[c, k, i, j]
             r0p[c, k, 3] = 0.0

@@ -27,7 +27,15 @@ rail on the wheel, track axes):
   is dominated by 4/dt^2 M, so its inverse is local: the rail's compliance at a
   wheel is the 12 x 12 block of K^-1 over the rail element under it (computed
   once by probing), and wheels (>= 2.5 m apart) do not see each other inside
-  one step.
+  one step. The rail element under a wheel also deflects within itself, beyond
+  what its nodes' cubic interpolation carries: r gets - C_i g, C_i the
+  element's interior flexibility at the wheel (the element clamped at its
+  nodes, :func:`ttb_sim.fe.beam.interior_compliance`; its velocity follows by
+  the trapezoidal rule). Without it the rail under a wheel would be stiffest at
+  the nodes and softest between them, a spurious excitation at the element
+  passing frequency V / L_e: mainly in the lateral force, through the rail's
+  twist, which the elements interpolate linearly (the static rail-head motion
+  under a wheel is now the same on any rail mesh).
 
 The contact laws close the system, all at the end of the step: Hertz's normal
 force on the vertical compression, the contact geometry (rolling radius,
@@ -66,6 +74,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from ttb_sim.errors import DivergenceError, ModelError
+from ttb_sim.fe.beam import interior_compliance
 from ttb_sim.fe.factorization import factorize
 from ttb_sim.model.bridge import Structure
 from ttb_sim.model.irregularity import TrackIrregularity
@@ -113,6 +122,20 @@ def gather(vector: np.ndarray, index: np.ndarray) -> np.ndarray:
     """
     n = vector.shape[0]
     return np.where(index < n, vector[np.minimum(index, n - 1)], 0.0)
+
+
+def rail_section_columns(rail: BeamLine) -> np.ndarray:
+    """
+    Return a rail's (n_el, 4) EA, GJ, EI_y, EI_z, for its interior flexibility.
+
+    A line without sections is taken as rigid between its nodes (infinite
+    stiffness: no interior flexibility).
+    """
+    sec = rail.section
+    if sec is None:
+        return np.full((rail.length.size, 4), np.inf)
+    return np.ascontiguousarray(np.column_stack([sec.ea, sec.gj, sec.ei_y, sec.ei_z]),
+                                dtype=float)
 
 
 @dataclass(frozen=True)
@@ -363,6 +386,8 @@ class TrainTrackCoupling(FreeDofState):
             raise ModelError('multibody cars need the slab track: the structure has none')
         self.rails = track.rails
         self.head_arm = np.array([0.0, 0.0, track.rail_head])
+        self._rail_sections = tuple(rail_section_columns(r) for r in self.rails)
+        """Each rail's (n_el, 4) EA, GJ, EI_y, EI_z, for the interior flexibility."""
         ftf = structure.full_to_free
         self.rail_dofs = tuple(ftf[r.dofs] for r in self.rails)
         self._kernels = ContactKernels.load() if getattr(integrator, 'lean', False) else None
@@ -392,6 +417,10 @@ class TrainTrackCoupling(FreeDofState):
         self._rail_offset = np.zeros((n, 8, COMPONENTS))
         self._wheelset_y = 6 * np.repeat(np.arange(3, 7), 2) + 1
         self._slope_offset = np.zeros((n, 8, 3))
+        self._interior = np.zeros((n, 8, 3))
+        """Interior deflection of the rail element under each wheel (m), :meth:`_rail_rows`."""
+        self._interior_v = np.zeros((n, 8, 3))
+        """Its velocity by the trapezoidal rule (m/s)."""
         self.solves = 0
         """Track solves of the last step."""
         self._zero = np.zeros(n_free)
@@ -404,13 +433,20 @@ class TrainTrackCoupling(FreeDofState):
 
     # -- geometry and kinematics ---------------------------------------------------------
     def _rail_rows(self, x: np.ndarray
-                   ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-        """Return rail-head rows R, R' (n_cars, 8, 3, 12), ext-free DOFs and B blocks."""
+                   ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """
+        Return rail-head rows R, R' (n_cars, 8, 3, 12), ext-free DOFs, B blocks and C_i.
+
+        C_i (n_cars, 8, 3, 3) is the interior flexibility of the rail element under
+        each wheel (:func:`ttb_sim.fe.beam.interior_compliance`): the rail head
+        under a wheel moves by R u - C_i F for the force F the wheel puts on it.
+        """
         shape = x.shape
         xi = np.zeros(shape)
         length = np.zeros(shape)
         dofs = np.zeros(shape + (12,), dtype=int)
         blocks = np.zeros(shape + (12, 12))
+        interior = np.zeros(shape + (3, 3))
         for r, side in enumerate((1.0, -1.0)):
             sel = self.side == side
             rail = self.rails[r]
@@ -422,9 +458,13 @@ class TrainTrackCoupling(FreeDofState):
             length[sel] = rail.length[element]
             dofs[sel] = self.rail_dofs[r][element]
             blocks[sel] = self.compliance.blocks[r][element]
+            sec = self._rail_sections[r][element]
+            interior[sel] = interior_compliance(xi[sel], length[sel], sec[:, 0], sec[:, 1],
+                                                sec[:, 2], sec[:, 3], float(self.head_arm[2]))
         # Rows and slopes of both rails in one evaluation (elementwise, so the same numbers).
         rows, slope = point_rows_and_slopes(xi.ravel(), length.ravel(), self.head_arm)
-        return rows.reshape(shape + (3, 12)), slope.reshape(shape + (3, 12)), dofs, blocks
+        return (rows.reshape(shape + (3, 12)), slope.reshape(shape + (3, 12)), dofs, blocks,
+                interior)
 
     def _irregularity(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Return vertical and lateral rail irregularity and lateral slope under each wheel."""
@@ -486,7 +526,7 @@ class TrainTrackCoupling(FreeDofState):
         """
         n = self.n_cars
         x = head + self.contact_x
-        rows, _, dofs, _ = self._rail_rows(x)
+        rows, _, dofs, _, interior = self._rail_rows(x)
         irr_z, irr_y, _ = self._irregularity(x)
         # The wheelsets start centred on the track (y = 0): with lateral irregularity
         # the rails are shifted under them, which raises or lowers each wheel's
@@ -501,6 +541,7 @@ class TrainTrackCoupling(FreeDofState):
         rhs[flat, np.arange(m)[:, None]] = rz
         zcol = np.vstack([lu.solve(rhs[:n_free]), np.zeros((1, m))])
         flex = np.einsum('ik,ikj->ij', rz, zcol[flat])     # r_z = -flex @ P
+        flex[np.diag_indices(m)] += interior[..., 2, 2].ravel()
         # Vertical subproblem: z, roll, pitch of body and bogies; z, roll of the
         # wheelsets (their pitch is the free spin).
         sub = np.sort(np.concatenate([car_dofs(range(3), ['z', 'roll', 'pitch']),
@@ -561,6 +602,8 @@ class TrainTrackCoupling(FreeDofState):
         self._rail_offset[:] = 0.0
         self._slope_offset[:] = 0.0
         self.force[..., 2] = load.reshape(n, 8)
+        self._interior = -interior[..., 2] * self.force[..., 2:3]
+        self._interior_v = np.zeros((n, 8, 3))
         w = np.einsum('ks,cs->ck', hz, q)
         self.compression = (-(flex @ load) + irr_z.ravel() - w.ravel()).reshape(n, 8)
         self.saturation[:] = 1.0
@@ -582,6 +625,12 @@ class TrainTrackCoupling(FreeDofState):
                 'table: the flange is climbing the rail (derailment). Usually the '
                 'car hunts at this speed; check car.yaw_dampers and car.yaw_damping')
 
+    def _accept_interior(self, interior: np.ndarray, force: np.ndarray, a1: float) -> None:
+        """Take the end-of-step interior deflection under the wheels and its velocity."""
+        now = -np.einsum('cwij,cwj->cwi', interior, force[..., :3])
+        self._interior_v = a1 * (now - self._interior) - self._interior_v
+        self._interior = now
+
     # -- one step -------------------------------------------------------------------------
     def step(self, head: float, speed: float) -> None:
         """Advance train, track and bridge together to the head position ``head``."""
@@ -596,7 +645,7 @@ class TrainTrackCoupling(FreeDofState):
         nm, n = self.nm, self.n_cars
         n_free = self.n_free
         x = head + self.contact_x
-        rows, slope, dofs, blocks = self._rail_rows(x)
+        rows, slope, dofs, blocks, interior = self._rail_rows(x)
         irr_z, irr_y, irr_dy = self._irregularity(x)
 
         # Predictors (no contact force).
@@ -614,8 +663,9 @@ class TrainTrackCoupling(FreeDofState):
         w_star = (q_star @ self.h.T).reshape(n, 8, COMPONENTS)
         w_hist = (qh_v @ self.h.T).reshape(n, 8, COMPONENTS)
 
-        # Local rail compliance: r = r* - Dr g_xyz, r' = r'* - Ds g_xyz.
-        dr = np.einsum('cwij,cwjk,cwlk->cwil', rows, blocks, rows)
+        # Local rail compliance: r = r* - Dr g_xyz, r' = r'* - Ds g_xyz; the rail head
+        # under a wheel also deflects within its element (Dr includes that, C_i).
+        dr = np.einsum('cwij,cwjk,cwlk->cwil', rows, blocks, rows) + interior
         ds = np.einsum('cwij,cwjk,cwlk->cwil', slope, blocks, rows)
 
         # Creep coefficients scaled with the previous step's normal load.
@@ -639,7 +689,9 @@ class TrainTrackCoupling(FreeDofState):
         r0p = np.zeros((n, 8, COMPONENTS))
         r0p[..., :3] = r_star
         rv0 = np.zeros((n, 8, COMPONENTS))
-        rv0[..., :3] = a1 * r_star + r_hist + speed * rs_star
+        # The interior deflection's velocity continues by the trapezoidal rule.
+        rv0[..., :3] = (a1 * r_star + r_hist + speed * rs_star
+                        - a1 * self._interior - self._interior_v)
         # Start from the last step's correction of the local rail model: it is what the
         # local blocks leave out (coupling of wheels through slab and girder) and
         # changes little from step to step, so one exact solve usually suffices.
@@ -722,7 +774,8 @@ class TrainTrackCoupling(FreeDofState):
             load = np.zeros(n_free + 1)
             np.add.at(load, dofs.ravel(), -np.einsum('cwij,cwi->cwj', rows, gx).ravel())
             u_new = u_star + nm.solve(load[:n_free])
-            r_exact = np.einsum('cwij,cwj->cwi', rows, gather(u_new, dofs))
+            r_exact = (np.einsum('cwij,cwj->cwi', rows, gather(u_new, dofs))
+                       - np.einsum('cwij,cwj->cwi', interior, gx))
             r_model = rp.reshape(n, 8, COMPONENTS)[..., :3] - np.einsum(
                 'cwij,cwj->cwi', dr, gx)
             mismatch = r_exact - r_model
@@ -745,6 +798,7 @@ class TrainTrackCoupling(FreeDofState):
         self.v, self.a = nm.finish(u_new, h_v, h_a)
         self.u = u_new
         self.force = g3
+        self._accept_interior(interior, g3, a1)
         self.compression = delta
         self._rail_y = r_exact[..., 1]
         self.saturation = eps
@@ -797,11 +851,13 @@ class TrainTrackCoupling(FreeDofState):
         element = self._buffer('element', (n, 8), np.intp)
         dr = self._buffer('dr', (n, 8, 3, 3))
         ds = self._buffer('ds', (n, 8, 3, 3))
+        interior = self._buffer('interior', (n, 8, 3, 3))
         left, right = self.rails
         off = k.rail_rows(x, self.side, left.start, left.length, self.rail_dofs[0],
-                          self.compliance.blocks[0], right.start, right.length,
-                          self.rail_dofs[1], self.compliance.blocks[1],
-                          float(self.head_arm[2]), rows, slope, dofs, dr, ds, element)
+                          self.compliance.blocks[0], self._rail_sections[0], right.start,
+                          right.length, self.rail_dofs[1], self.compliance.blocks[1],
+                          self._rail_sections[1], float(self.head_arm[2]), rows, slope, dofs,
+                          dr, ds, interior, element)
         if off >= 0:
             raise DivergenceError('a wheel ran off the modelled track at x = '
                                   f'{x.flat[off]:.2f} m; the run is longer than '
@@ -842,9 +898,14 @@ class TrainTrackCoupling(FreeDofState):
         rv0 = self._buffer('rv0', (n, 8, COMPONENTS))
         rvel = self._buffer('rvel', (n, 8, 3, 3))
         y_star = self._buffer('y_star', (n, 8))
-        k.contact_setup(self.force, self._creep0, float(self.p0), r_star, rs_star, r_hist, dr,
-                        ds, a1, float(speed), q_star, self._wheelset_y, creep, r0p, rv0, rvel,
-                        y_star)
+        # The contact iteration's rail model includes the interior flexibility; the check
+        # of the solved track compares the nodes' part (the interior one is the same in
+        # both).
+        dr_model = self._buffer('dr_model', (n, 8, 3, 3))
+        np.add(dr, interior, out=dr_model)
+        k.contact_setup(self.force, self._creep0, float(self.p0), r_star, rs_star, r_hist,
+                        self._interior, self._interior_v, dr_model, ds, a1, float(speed), q_star,
+                        self._wheelset_y, creep, r0p, rv0, rvel, y_star)
         offset = self._rail_offset.copy()
         slope_offset = self._slope_offset.copy()
         lateral, radius_table, angle_table, rise, roll = self._tables
@@ -859,7 +920,7 @@ class TrainTrackCoupling(FreeDofState):
         total_iter = 0
         for _outer in range(self.max_iter):
             iterations, change = k.contact_newton(
-                g, w0, wv0, r0p, rv0, offset, slope_offset, self.dw, dr, rvel, self.ey,
+                g, w0, wv0, r0p, rv0, offset, slope_offset, self.dw, dr_model, rvel, self.ey,
                 y_star, irr_y, irr_z, irr_dy, self.side, creep, lateral, radius_table,
                 angle_table, rise, roll, float(self.params.contact_semi_distance),
                 float(self.contact.conicity), float(self.r0), self.g_hertz,
@@ -898,8 +959,9 @@ class TrainTrackCoupling(FreeDofState):
         self.v, self.a = nm.finish(u_new, h_v, h_a)
         self.u = u_new
         self.force = g.reshape(n, 8, COMPONENTS)
+        self._accept_interior(interior, self.force, a1)
         self.compression = delta
-        self._rail_y = r_exact[..., 1].copy()
+        self._rail_y = r_exact[..., 1] + self._interior[..., 1]
         self.saturation = eps
         self.iterations = total_iter
         self.solves = _outer + 1 + (0 if single else 1)
