@@ -69,7 +69,10 @@ class Newmark:
         self.lean = lean
         if lean:
             n = self.mass.shape[0]
+            # Without the stored zeros of the assembly (72 % of paper_ttbi's mass entries:
+            # the beams' element blocks are stored whole): a zero adds nothing to a sum.
             self._stacked = sp.hstack([self.mass, self.damping], format='csr')
+            self._stacked.eliminate_zeros()
             self._history = np.zeros(2 * n)
             self._h_a, self._h_v = self._history[:n], self._history[n:]
             self._work = np.zeros(n)
