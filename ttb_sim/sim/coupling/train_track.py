@@ -31,11 +31,11 @@ rail on the wheel, track axes):
   what its nodes' cubic interpolation carries: r gets - C_i g, C_i the
   element's interior flexibility at the wheel (the element clamped at its
   nodes, :func:`ttb_sim.fe.beam.interior_compliance`; its velocity follows by
-  the trapezoidal rule). Without it the rail under a wheel would be stiffest at
-  the nodes and softest between them, a spurious excitation at the element
-  passing frequency V / L_e: mainly in the lateral force, through the rail's
-  twist, which the elements interpolate linearly (the static rail-head motion
-  under a wheel is now the same on any rail mesh).
+  the trapezoidal rule). Without it the rail would be too stiff under a wheel
+  between its nodes, and the wheel would feel that at the element-passing
+  frequency V / L_e: mainly in the lateral force, through the rail's twist,
+  which the elements interpolate linearly. With it the static rail-head motion
+  under a wheel is the same on any rail mesh.
 
 The contact laws close the system, all at the end of the step: Hertz's normal
 force on the vertical compression, the contact geometry (rolling radius,
