@@ -30,6 +30,7 @@ moving-load vectors all follow from one definition of the shape functions.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -343,6 +344,24 @@ def interior_compliance(xi: np.ndarray, length: np.ndarray, ea: np.ndarray, gj: 
     """
     xi = np.asarray(xi, dtype=float)
     length = np.asarray(length, dtype=float)
+    xx, xz, yy, zz = interior_terms(xi, length, ea, gj, ei_y, ei_z, height)
+    out = np.zeros(xi.shape + (3, 3))
+    out[..., 0, 0] = xx
+    out[..., 0, 2] = out[..., 2, 0] = xz
+    out[..., 1, 1] = yy
+    out[..., 2, 2] = zz
+    return out
+
+
+def interior_terms(xi: Any, length: Any, ea: Any, gj: Any, ei_y: Any, ei_z: Any,
+                   height: float) -> tuple[Any, Any, Any, Any]:
+    """
+    Return the non-zero entries xx, xz (= zx), yy, zz of :func:`interior_compliance`.
+
+    Elementwise arithmetic only, so the same function serves numpy arrays and,
+    compiled, the scalars of the contact kernels
+    (:func:`ttb_sim.sim.contact_kernels.rail_rows`).
+    """
     a = xi * length
     b = (1.0 - xi) * length
     ab = a * b
@@ -350,9 +369,5 @@ def interior_compliance(xi: np.ndarray, length: np.ndarray, ea: np.ndarray, gj: 
     deflection = ab**3 / (3.0 * cube)
     rotation = ab * (a * a - ab + b * b) / cube
     coupling = (a - b) * ab * ab / (2.0 * cube)
-    out = np.zeros(xi.shape + (3, 3))
-    out[..., 0, 0] = ab / (length * ea) + height**2 * rotation / ei_y
-    out[..., 0, 2] = out[..., 2, 0] = height * coupling / ei_y
-    out[..., 1, 1] = deflection / ei_z + height**2 * ab / (length * gj)
-    out[..., 2, 2] = deflection / ei_y
-    return out
+    return (ab / (length * ea) + height**2 * rotation / ei_y, height * coupling / ei_y,
+            deflection / ei_z + height**2 * ab / (length * gj), deflection / ei_y)

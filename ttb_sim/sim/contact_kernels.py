@@ -49,11 +49,12 @@ import math
 
 import numpy as np
 
+from ttb_sim.fe.beam import interior_terms
 from ttb_sim.model.wheel_rail.creep import CREEP_LOAD_EXPONENTS
 
 COMPONENTS = 4
 """Contact force components per wheel: Fx, Fy, Fz, Mz."""
-HELPERS = ('_hermite', '_interior', '_interp', '_interval', '_solve_in_place',
+HELPERS = ('_hermite', 'interior_terms', '_interp', '_interval', '_solve_in_place',
            '_wheel_force_products', 'quintic')
 """Functions the kernels call: :func:`ttb_sim.sim.kernels.compiled` compiles them first."""
 prange = range
@@ -83,25 +84,6 @@ def _hermite(xi: float, length: float, derivative: int, out: np.ndarray) -> None
         out[1] = (-4 + 6 * xi) * length * scale
         out[2] = (6 - 12 * xi) * scale
         out[3] = (-2 + 6 * xi) * length * scale
-
-
-def _interior(xi: float, length: float, section: np.ndarray, height: float,
-              out: np.ndarray) -> None:
-    """Interior flexibility of an element under a head load (beam.interior_compliance)."""
-    a = xi * length
-    b = (1.0 - xi) * length
-    ab = a * b
-    cube = length**3
-    deflection = ab**3 / (3.0 * cube)
-    rotation = ab * (a * a - ab + b * b) / cube
-    coupling = (a - b) * ab * ab / (2.0 * cube)
-    ea, gj, ei_y, ei_z = section[0], section[1], section[2], section[3]
-    out[:, :] = 0.0
-    out[0, 0] = ab / (length * ea) + height**2 * rotation / ei_y
-    out[0, 2] = height * coupling / ei_y
-    out[2, 0] = out[0, 2]
-    out[1, 1] = deflection / ei_z + height**2 * ab / (length * gj)
-    out[2, 2] = deflection / ei_y
 
 
 def rail_rows(x: np.ndarray, side: np.ndarray, start_l: np.ndarray, length_l: np.ndarray,
@@ -166,7 +148,15 @@ def rail_rows(x: np.ndarray, side: np.ndarray, start_l: np.ndarray, length_l: np
                 return c * n_wheels + k
             xi = min(max(local / el, 0.0), 1.0)
             element[c, k] = e
-            _interior(xi, el, section[e], arm, interior[c, k])
+            flex = interior[c, k]
+            flex[:, :] = 0.0
+            xx, xz, yy, zz = interior_terms(xi, el, section[e, 0], section[e, 1],
+                                            section[e, 2], section[e, 3], arm)
+            flex[0, 0] = xx
+            flex[0, 2] = xz
+            flex[2, 0] = xz
+            flex[1, 1] = yy
+            flex[2, 2] = zz
             for d in range(3):
                 _hermite(xi, el, d, h[d])
             for order in range(2):

@@ -125,15 +125,9 @@ def gather(vector: np.ndarray, index: np.ndarray) -> np.ndarray:
 
 
 def rail_section_columns(rail: BeamLine) -> np.ndarray:
-    """
-    Return a rail's (n_el, 4) EA, GJ, EI_y, EI_z, for its interior flexibility.
-
-    A line without sections is taken as rigid between its nodes (infinite
-    stiffness: no interior flexibility).
-    """
+    """Return a rail's (n_el, 4) EA, GJ, EI_y, EI_z, for its interior flexibility."""
     sec = rail.section
-    if sec is None:
-        return np.full((rail.length.size, 4), np.inf)
+    assert sec is not None, 'the rails carry their sections (build_track)'
     return np.ascontiguousarray(np.column_stack([sec.ea, sec.gj, sec.ei_y, sec.ei_z]),
                                 dtype=float)
 
