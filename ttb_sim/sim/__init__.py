@@ -18,11 +18,22 @@ The stepping core: build step, integrators, couplings, the simulation loop, fram
 ``build`` turns a scenario into model objects (the only reader of the scenario
 tree), ``integrators`` holds the integrator protocol and Newmark, ``coupling`` the
 vehicle-structure couplings behind one protocol, ``simulation`` the one stepping
-loop that yields :class:`Frame` objects, ``variants`` and ``lean`` the solver
-variants.
+loop that yields :class:`Frame` objects, ``variants`` the solver variants.
+
+The names below are the package's face: the layers above (commands, node,
+validation) take what they need of the stepping core from here.
 """
 
+from ttb_sim.sim.build import build_structure, build_vehicle
+from ttb_sim.sim.cost import CostEstimate, estimate_cost, STEP_BUDGET
 from ttb_sim.sim.frames import Frame, Layout
+from ttb_sim.sim.integrators.newmark import Newmark
+from ttb_sim.sim.pile_soil import implicit_dofs
+from ttb_sim.sim.runner import make_runner, Runner
 from ttb_sim.sim.simulation import Simulation
+from ttb_sim.sim.substructure_run import reference_refusal, SubstructureRun
+from ttb_sim.sim.variants import blas_threads, solver_variant, VARIANTS
 
-__all__ = ['Frame', 'Layout', 'Simulation']
+__all__ = ['blas_threads', 'build_structure', 'build_vehicle', 'CostEstimate', 'estimate_cost',
+           'Frame', 'implicit_dofs', 'Layout', 'make_runner', 'Newmark', 'reference_refusal',
+           'Runner', 'Simulation', 'solver_variant', 'STEP_BUDGET', 'SubstructureRun', 'VARIANTS']
