@@ -163,41 +163,6 @@ def _peak_rss_mib() -> float | None:
     return peak * scale / 2**20
 
 
-def _substructure_dof_counts(run: Any) -> dict[str, int]:
-    """
-    DOF counts of a pile-soil substructure run, per subsystem.
-
-    Free DOFs of the nodes of soil, pile and cap bricks, of the interface
-    elements and of the boundary springs and dashpots (a node shared by two
-    subsystems counts in both); ``total`` is every free DOF and ``solved`` those
-    the step (or the static solve) factorises: all of them in the implicit
-    scheme, the piles, cap and interface in the mixed one.
-    """
-    from ttb_sim.model.foundation.substructure import CAP, PILE, SOIL
-    from ttb_sim.sim.pile_soil import implicit_dofs
-
-    model = run.model
-    free = model.free
-
-    def of_cells(kind: int) -> int:
-        nodes = np.unique(model.mesh.cells[model.cell_kind == kind])
-        dofs = (3 * nodes[:, None] + np.arange(3)).ravel()
-        return int(np.count_nonzero(free[dofs]))
-
-    interface = 0
-    if model.interface is not None:
-        touched = np.unique(model.interface.relative.indices)
-        interface = int(np.count_nonzero(free[touched]))
-    boundary = (model.boundary_stiffness.diagonal() != 0) | (model.boundary_damping.diagonal()
-                                                             != 0)
-    total = int(np.count_nonzero(free))
-    solved = total if run.scheme == 'implicit' else int(np.count_nonzero(implicit_dofs(model)
-                                                                         & free))
-    return {'soil': of_cells(SOIL), 'piles': of_cells(PILE), 'cap': of_cells(CAP),
-            'interface': interface, 'boundary': int(np.count_nonzero(boundary & free)),
-            'total': total, 'solved': solved}
-
-
 def measure(scenario: str, variant: str, duration: float | None = None,
             overrides: Sequence[str] = ()) -> tuple[dict[str, Any], Traces]:
     """
@@ -227,7 +192,7 @@ def measure(scenario: str, variant: str, duration: float | None = None,
 
     """
     from ttb_sim.config import load_scenario
-    from ttb_sim.sim.runner import make_runner
+    from ttb_sim.sim import make_runner, substructure_dof_counts
 
     values: list[tuple[str, Any]] = [('solver.variant', variant)]
     if duration is not None:
@@ -272,7 +237,7 @@ def measure(scenario: str, variant: str, duration: float | None = None,
         'factorization': sim.factorization if substructure else sim.integrator.method,
         'status': status,
         'message': message,
-        'dofs': _substructure_dof_counts(sim) if substructure else _dof_counts(sim),
+        'dofs': substructure_dof_counts(sim) if substructure else _dof_counts(sim),
         'bricks': bricks,
         'dt': sim.dt,
         'steps': steps,
@@ -476,7 +441,7 @@ def _plan(scenario: str, variants: Sequence[str], duration: float | None,
           overrides: Sequence[str]) -> _Plan:
     """Check one workload before anything runs (a bad scenario raises ScenarioError)."""
     from ttb_sim.config import load_scenario
-    from ttb_sim.sim.substructure_run import reference_refusal
+    from ttb_sim.sim import reference_refusal
 
     workload = DEFAULT_WORKLOADS.get(scenario, Workload())
     names = check_variants(variants or workload.variants or variant_names())

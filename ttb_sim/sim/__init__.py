@@ -28,12 +28,13 @@ from ttb_sim.sim.build import build_structure, build_vehicle
 from ttb_sim.sim.cost import CostEstimate, estimate_cost, STEP_BUDGET
 from ttb_sim.sim.frames import Frame, Layout
 from ttb_sim.sim.integrators.newmark import Newmark
-from ttb_sim.sim.pile_soil import implicit_dofs
 from ttb_sim.sim.runner import make_runner, Runner
 from ttb_sim.sim.simulation import Simulation
-from ttb_sim.sim.substructure_run import reference_refusal, SubstructureRun
+from ttb_sim.sim.substructure_run import (reference_refusal, substructure_dof_counts,
+                                          SubstructureRun)
 from ttb_sim.sim.variants import blas_threads, solver_variant, VARIANTS
 
 __all__ = ['blas_threads', 'build_structure', 'build_vehicle', 'CostEstimate', 'estimate_cost',
-           'Frame', 'implicit_dofs', 'Layout', 'make_runner', 'Newmark', 'reference_refusal',
-           'Runner', 'Simulation', 'solver_variant', 'STEP_BUDGET', 'SubstructureRun', 'VARIANTS']
+           'Frame', 'Layout', 'make_runner', 'Newmark', 'reference_refusal',
+           'Runner', 'Simulation', 'solver_variant', 'STEP_BUDGET', 'substructure_dof_counts',
+           'SubstructureRun', 'VARIANTS']

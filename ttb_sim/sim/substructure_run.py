@@ -51,10 +51,11 @@ import numpy as np
 from ttb_sim.config import Scenario
 from ttb_sim.errors import DivergenceError, ScenarioError
 from ttb_sim.fe.factorization import resolve
-from ttb_sim.model.foundation.substructure import build, PileSoilModel, planned_nodes
+from ttb_sim.model.foundation.substructure import (build, CAP, PILE, PileSoilModel, planned_nodes,
+                                                   SOIL)
 from ttb_sim.sim.cost import CostEstimate, STEP_BUDGET
 from ttb_sim.sim.frames import Frame, Layout
-from ttb_sim.sim.pile_soil import (initial_state, mixed_stable_step, observe,
+from ttb_sim.sim.pile_soil import (implicit_dofs, initial_state, mixed_stable_step, observe,
                                    PartitionedNewmark, State, static_solve)
 from ttb_sim.sim.variants import blas_threads, solver_variant, VARIANTS
 
@@ -266,3 +267,35 @@ class SubstructureRun:
                      pile_displacement=obs.pile_displacement,
                      pile_acceleration=obs.pile_acceleration,
                      pile_rotation_rate=obs.pile_rotation_rate, soil_points=points)
+
+
+def substructure_dof_counts(run: SubstructureRun) -> dict[str, int]:
+    """
+    DOF counts of a pile-soil substructure run, per subsystem.
+
+    Free DOFs of the nodes of soil, pile and cap bricks, of the interface
+    elements and of the boundary springs and dashpots (a node shared by two
+    subsystems counts in both); ``total`` is every free DOF and ``solved`` those
+    the step (or the static solve) factorises: all of them in the implicit
+    scheme, the piles, cap and interface in the mixed one.
+    """
+    model = run.model
+    free = model.free
+
+    def of_cells(kind: int) -> int:
+        nodes = np.unique(model.mesh.cells[model.cell_kind == kind])
+        dofs = (3 * nodes[:, None] + np.arange(3)).ravel()
+        return int(np.count_nonzero(free[dofs]))
+
+    interface = 0
+    if model.interface is not None:
+        touched = np.unique(model.interface.relative.indices)
+        interface = int(np.count_nonzero(free[touched]))
+    boundary = (model.boundary_stiffness.diagonal() != 0) | (model.boundary_damping.diagonal()
+                                                             != 0)
+    total = int(np.count_nonzero(free))
+    solved = total if run.scheme == 'implicit' else int(np.count_nonzero(implicit_dofs(model)
+                                                                         & free))
+    return {'soil': of_cells(SOIL), 'piles': of_cells(PILE), 'cap': of_cells(CAP),
+            'interface': interface, 'boundary': int(np.count_nonzero(boundary & free)),
+            'total': total, 'solved': solved}
