@@ -39,7 +39,7 @@ setup(
                       # without it the variants fall back to scipy / leave BLAS threads as
                       # they are.
                       'cholespy>=2.0', 'qdldl>=0.1.7', 'threadpoolctl>=3',
-                      # compiled kernels of the lean step (ttb_sim/sim/kernels.py); without
+                      # compiled kernels of the lean step (ttb_sim/sim/kernel_registry.py); without
                       # it the numpy twins run.
                       'numba>=0.59'],
     extras_require={

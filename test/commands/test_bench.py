@@ -160,7 +160,7 @@ def test_substructure_workload_rows_dof_counts_and_difference():
 
 
 def test_a_refused_reference_leaves_the_other_variants_running(monkeypatch):
-    from ttb_sim.sim import substructure_run
+    from ttb_sim.sim.substructure import standalone as substructure_run
 
     monkeypatch.setattr(substructure_run, 'IMPLICIT_MAX_DOFS', 1000)
     report = bn.bench(['single_pile'], ['qdldl'], 0.01, isolate=False, overrides=PILE)

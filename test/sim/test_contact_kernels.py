@@ -12,18 +12,19 @@
 # See the License for the specific language governing permissions and
 # limitations under the License.
 
-"""The compiled contact step against the numpy step, and its single track solve."""
+"""The compiled contact step against its numpy oracle, and its single track solve."""
 
 from __future__ import annotations
 
 import numpy as np
 import pytest
 
+from contact_oracle import use_numpy_step  # noqa: I100 - the oracle in test/sim
 from ttb_sim.config import load_scenario
 import ttb_sim.model.wheel_rail as ct
-from ttb_sim.sim import kernels
-from ttb_sim.sim.coupling import train_track
-from ttb_sim.sim.simulation import Simulation
+from ttb_sim.sim import Simulation
+from ttb_sim.sim.coupling.train_track import contact_step, multibody
+from ttb_sim.sim.coupling.train_track.equilibrium import rail_under_wheels
 
 pytest.importorskip('numba')
 
@@ -36,10 +37,17 @@ SMALL = [('train.vehicle', 'car'), ('track.model', 'slab'), ('train.n_cars', 1),
 Run = tuple[Simulation, np.ndarray, np.ndarray, list[int]]
 
 
-def passage(duration: float, extra: list | None = None) -> Run:
-    """One car onto a one-span bridge: wheel-rail forces, mid-span and solves per step."""
+def passage(duration: float, extra: list | None = None, *, numpy: bool = False) -> Run:
+    """
+    One car onto a one-span bridge: wheel-rail forces, mid-span and solves per step.
+
+    ``numpy`` takes the oracle's numpy step (``contact_oracle.py``) instead of the
+    compiled one.
+    """
     sim = Simulation(load_scenario('moving_force_beam', values=SMALL + [
         ('solver.duration', duration)] + (extra or [])))
+    if numpy:
+        use_numpy_step(sim.coupling)
     forces, midspan, solves = [], [], []
     for frame in sim.frames():
         forces.append(frame.wheel_rail.copy())
@@ -57,11 +65,10 @@ def relative(a: np.ndarray, b: np.ndarray) -> float:
 def test_compiled_two_solve_step_is_the_numpy_step_to_round_off(monkeypatch, geometry):
     """Kernels with the numpy step's two solves: the same passage within 1e-9 (round-off)."""
     extra = [('contact.geometry', geometry)]
-    monkeypatch.setattr(train_track, 'INFLUENCE_HOPS', None)
+    monkeypatch.setattr(multibody, 'INFLUENCE_HOPS', None)
     fast, f_fast, m_fast, _ = passage(0.06, extra)
-    monkeypatch.setattr(kernels, 'ENABLED', False)
-    slow, f_slow, m_slow, _ = passage(0.06, extra)
-    assert fast.coupling._kernels is not None and slow.coupling._kernels is None
+    slow, f_slow, m_slow, _ = passage(0.06, extra, numpy=True)
+    assert 'step' in vars(slow.coupling) and 'step' not in vars(fast.coupling)
     assert not fast.coupling.compliance.influence
     # The compression moves 10 um and more over the run: the comparison is not idle.
     assert np.ptp(f_slow[..., 2]) > 1e3
@@ -80,7 +87,7 @@ def test_local_columns_give_the_rail_motion_of_the_predictor_solve():
         ('solver.duration', 0.06)]))
     tt = sim.coupling
     assert tt.compliance.influence
-    k = tt._kernels
+    k = tt.contact_step.kernels
     n = tt.n_cars
     checked = 0
     for i, _ in enumerate(sim.frames()):
@@ -93,14 +100,14 @@ def test_local_columns_give_the_rail_motion_of_the_predictor_solve():
         dr, ds = np.zeros((n, 8, 3, 3)), np.zeros((n, 8, 3, 3))
         interior = np.zeros((n, 8, 3, 3))
         left, right = tt.rails
-        sec_l, sec_r = tt._rail_sections
+        sec_l, sec_r = tt.rail_sections
         assert k.rail_rows(x, tt.side, left.start, left.length, tt.rail_dofs[0],
                            tt.compliance.blocks[0], sec_l, right.start, right.length,
                            tt.rail_dofs[1], tt.compliance.blocks[1], sec_r,
                            float(tt.head_arm[2]), rows, slope, dofs, dr, ds, interior,
                            element) == -1
         # The numpy rows of the same wheels.
-        rows_np, slope_np, dofs_np, _, interior_np = tt._rail_rows(x)
+        rows_np, slope_np, dofs_np, _, interior_np = rail_under_wheels(tt, x)
         np.testing.assert_allclose(rows, rows_np, rtol=0, atol=1e-12)
         np.testing.assert_allclose(slope, slope_np, rtol=0, atol=1e-12)
         assert np.array_equal(dofs, dofs_np)
@@ -124,7 +131,7 @@ def test_local_columns_give_the_rail_motion_of_the_predictor_solve():
     assert checked >= 3
 
 
-def test_single_solve_step_solves_once_and_meets_the_contact_tolerance(monkeypatch):
+def test_single_solve_step_solves_once_and_meets_the_contact_tolerance():
     """
     One track solve per step; the passage equals the numpy step's to the contact tolerance.
 
@@ -139,8 +146,7 @@ def test_single_solve_step_solves_once_and_meets_the_contact_tolerance(monkeypat
     assert np.mean(solves) < 1.05
     tight = [('contact.tolerance', 1e-11)]
     _, f_tight, m_tight, _ = passage(0.06, tight)
-    monkeypatch.setattr(kernels, 'ENABLED', False)
-    _, f_numpy, m_numpy, solves_numpy = passage(0.06, tight)
+    _, f_numpy, m_numpy, solves_numpy = passage(0.06, tight, numpy=True)
     assert min(solves_numpy) == 2
     tt = sim.coupling
     worth = ct.linearised_stiffness(tt.p0, tt.g_hertz) * tt.tol / np.max(np.abs(f_numpy))
@@ -169,10 +175,10 @@ def test_step_setup_and_rail_check_are_the_numpy_formulas():
     a1, speed, p0 = 2e4, 80.0, 7e4
     creep, r0p, rv0 = np.empty((4, n, 8)), np.empty((n, 8, 4)), np.empty((n, 8, 4))
     rvel, y_star = np.empty((n, 8, 3, 3)), np.empty((n, 8))
-    kernels.compiled('contact_setup')(force, creep0, p0, r_star, rs_star, r_hist, interior_r,
-                                      interior_v, dr, ds, a1, speed, q_star, wheelset_y, creep,
-                                      r0p, rv0, rvel, y_star)
-    expected = train_track.ct.scaled_creep_coefficients(tuple(creep0), p0, force[..., 2])
+    setup = contact_step.KERNELS.compiled('contact_setup')
+    setup(force, creep0, p0, r_star, rs_star, r_hist, interior_r, interior_v, dr, ds, a1, speed,
+          q_star, wheelset_y, creep, r0p, rv0, rvel, y_star)
+    expected = ct.scaled_creep_coefficients(tuple(creep0), p0, force[..., 2])
     np.testing.assert_allclose(creep, np.array(expected), rtol=1e-15, atol=0)
     np.testing.assert_array_equal(r0p[..., :3], r_star)
     np.testing.assert_allclose(rv0[..., :3], a1 * r_star + r_hist + speed * rs_star
@@ -194,7 +200,7 @@ def test_step_setup_and_rail_check_are_the_numpy_formulas():
     gx = g.reshape(n, 8, 4)[..., :3]
     miss = exact - ((r0p + offset)[..., :3] - np.einsum('cwij,cwj->cwi', dr, gx))
     miss_slope = exact_slope - (rs_star + slope_offset - np.einsum('cwij,cwj->cwi', ds, gx))
-    check = kernels.compiled('rail_check')
+    check = contact_step.KERNELS.compiled('rail_check')
     for single in (True, False):
         r_exact, mismatch, slope_mismatch = (np.empty((n, 8, 3)) for _ in range(3))
         worst = check(rows, slope, u, dofs, r0p, offset, dr, ds, g, rs_star, slope_offset,

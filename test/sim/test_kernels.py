@@ -20,10 +20,9 @@ import numpy as np
 import pytest
 
 from ttb_sim.config import load_scenario
-from ttb_sim.sim import kernels
-from ttb_sim.sim.integrators.newmark import Newmark
-from ttb_sim.sim.lean import MovingLoad
-from ttb_sim.sim.simulation import Simulation
+from ttb_sim.sim import kernel_registry as kernels, Newmark, Simulation
+from ttb_sim.sim.coupling.girder_load import MovingLoad
+from ttb_sim.sim.integrators.newmark_kernels import KERNELS
 
 pytest.importorskip('numba')
 
@@ -37,9 +36,9 @@ def numpy_twins(monkeypatch):
 
 
 def test_switch_off_gives_no_kernel(monkeypatch):
-    assert kernels.compiled('history') is not None
+    assert KERNELS.compiled('history') is not None
     monkeypatch.setattr(kernels, 'ENABLED', False)
-    assert kernels.compiled('history') is None
+    assert KERNELS.compiled('history') is None
 
 
 def test_compiled_moving_load_is_the_numpy_load_bit_for_bit(numpy_twins):

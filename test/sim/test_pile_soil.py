@@ -26,9 +26,8 @@ from ttb_sim.model.foundation.records import (BlockSize, Interface, MeshSize, Ob
                                               PAPER_LAYERS, PileGroup, PileLoad, SoilParameters,
                                               Substructure)
 from ttb_sim.model.foundation.substructure import build
-from ttb_sim.sim.pile_soil import (initial_state, observe, PartitionedNewmark,
-                                   stable_time_step, states)
-from ttb_sim.sim.substructure_run import SubstructureRun
+from ttb_sim.sim.substructure import observe, PartitionedNewmark, states, SubstructureRun
+from ttb_sim.sim.substructure.stepping import initial_state, stable_time_step
 from ttb_sim.validation.cases.pile_soil import (boundary_reflection, harmonic_convergence,
                                                 head_stiffness, randolph_wroth_reference,
                                                 single_pile)

@@ -30,7 +30,7 @@ import pytest
 from ttb_sim.model.bridge import (assemble_structure, BearingParameters, BridgeParameters,
                                   FoundationParameters, PierParameters)
 from ttb_sim.model.vehicle.train import Axles, QuarterCars
-from ttb_sim.sim.coupling.quarter_car import QuarterCarCoupling
+from ttb_sim.sim.coupling.quarter_car.wheels import QuarterCarCoupling
 from ttb_sim.sim.integrators.newmark import Newmark
 
 MS, MU, K = 5750.0, 400.0, 1.595e6

@@ -24,7 +24,7 @@ irregular track.
 import numpy as np
 import pytest
 from ttb_sim.config import load_scenario
-import ttb_sim.sim.coupling.quarter_car as quarter_car
+import ttb_sim.sim.coupling.quarter_car.wheels as quarter_car
 from ttb_sim.sim.simulation import Simulation
 
 OVERRIDES = [('bridge.n_spans', 2), ('bridge.elements_per_span', 8),

@@ -13,7 +13,9 @@
 # limitations under the License.
 
 """
-The compiled quarter-car step (:mod:`ttb_sim.sim.quarter_car_kernels`) against its numpy path.
+The compiled quarter-car step against its numpy path.
+
+The kernels are :mod:`ttb_sim.sim.coupling.quarter_car.wheel_kernels`.
 
 The node's default scenario ``live_train`` (16 quarter cars on irregular track,
 ten spans on bearings) is stepped through the numpy path and the kernels from
@@ -28,8 +30,9 @@ import itertools
 import numpy as np
 import pytest
 from ttb_sim.config import load_scenario
-from ttb_sim.sim import kernels, quarter_car_kernels
-from ttb_sim.sim.coupling.quarter_car import QuarterCarTrain
+from ttb_sim.sim import kernel_registry as kernels
+from ttb_sim.sim.coupling.quarter_car import wheel_kernels
+from ttb_sim.sim.coupling.quarter_car.wheels import QuarterCarTrain
 from ttb_sim.sim.runner import make_runner
 
 pytest.importorskip('numba')
@@ -84,7 +87,7 @@ def test_centreline_profile_equals_sample():
     assert irr is not None
     x = np.concatenate([np.linspace(irr.x_start - 3.0, irr.x_end + 3.0, 997),
                         [irr.x_start, irr.x_end]])
-    kernel = quarter_car_kernels.compiled('centreline_profile')
+    kernel = wheel_kernels.KERNELS.compiled('centreline_profile')
     assert kernel is not None
     out = (np.zeros(x.size), np.zeros(x.size), np.zeros(x.size))
     kernel(x, irr.x_start, irr.dx, irr.values, irr.slopes, irr.curvatures, 1e-9, *out)

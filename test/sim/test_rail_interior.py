@@ -36,7 +36,7 @@ import pytest
 from ttb_sim.config import load_scenario
 from ttb_sim.fe.beam import interior_compliance, point_rows
 from ttb_sim.fe.factorization import factorize
-from ttb_sim.sim.coupling.train_track import rail_section_columns
+from ttb_sim.sim.coupling.train_track.multibody import rail_section_columns
 from ttb_sim.sim.simulation import Simulation
 
 SMALL = [('train.vehicle', 'car'), ('track.model', 'slab'), ('train.n_cars', 1),

@@ -21,11 +21,12 @@ import pytest
 import scipy.sparse.linalg as sla
 
 from ttb_sim.config import load_scenario
-from ttb_sim.sim import reduced_track
-from ttb_sim.sim.build import build_structure
-from ttb_sim.sim.reduced_track import (project, rail_cuts, rigid_track_basis, slab_joints,
-                                       static_track_basis, track_free_dofs, track_window)
-from ttb_sim.sim.simulation import Simulation
+from ttb_sim.sim import build_structure, Simulation
+from ttb_sim.sim.coupling.train_track import reduced_track
+from ttb_sim.sim.coupling.train_track.equilibrium import rail_under_wheels
+from ttb_sim.sim.coupling.train_track.reduced_track import (project, rail_cuts, rigid_track_basis,
+                                                            slab_joints, static_track_basis,
+                                                            track_free_dofs, track_window)
 
 SMALL = [('train.vehicle', 'car'), ('track.model', 'slab'), ('train.n_cars', 1),
          ('bridge.n_spans', 3), ('bearings.model', 'elastic'), ('train.start_position', 40.0),
@@ -175,9 +176,7 @@ def test_window_predicts_its_rail_motion_from_the_full_models_columns(monkeypatc
     up to 1.1e-10 m, 1e-7 of the rail motion, on this small model whose far
     track lies close to the wheels).
     """
-    from ttb_sim.sim import kernels
-    if not kernels.ENABLED:
-        pytest.skip('the single-solve step needs numba (the compiled contact step)')
+    pytest.importorskip('numba', reason='the single-solve step is taken compiled')
     monkeypatch.setattr(reduced_track, 'ADVANCE', 1.0)
     sim = Simulation(load_scenario('moving_force_beam', values=SMALL + SHORT_UNITS + [
         ('solver.variant', 'reduced'), ('solver.duration', 0.06),
@@ -191,7 +190,7 @@ def test_window_predicts_its_rail_motion_from_the_full_models_columns(monkeypatc
             continue
         assert tt.compliance.influence
         head = sim.scenario.train.start_position + sim.speed * i * sim.output_every * sim.dt
-        rows, slope, dofs, _, _ = tt._rail_rows(head + tt.contact_x)
+        rows, slope, dofs, _, _ = rail_under_wheels(tt, head + tt.contact_x)
         element = np.searchsorted(tt.rails[0].start, head + tt.contact_x, side='right') - 1
         nm = tt.nm
         rhs = nm.effective_load(np.zeros(tt.n_free), *nm.history(tt.u, tt.v, tt.a)).copy()
@@ -199,8 +198,8 @@ def test_window_predicts_its_rail_motion_from_the_full_models_columns(monkeypatc
         r_exact = np.einsum('cwij,cwj->cwi', rows, exact)
         r_local, s_local = np.zeros((n, 8, 3)), np.zeros((n, 8, 3))
         infl_l, infl_r = tt.compliance.influence
-        tt._kernels.rail_predictor(element, tt.side, *infl_l, *infl_r, rows, slope, rhs,
-                                   r_local, s_local)
+        tt.contact_step.kernels.rail_predictor(element, tt.side, *infl_l, *infl_r, rows, slope,
+                                               rhs, r_local, s_local)
         assert np.max(np.abs(r_exact)) > 1e-4       # the rail is loaded
         assert np.max(np.abs(r_local - r_exact)) < tt.tol
         checked += 1

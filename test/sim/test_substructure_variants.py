@@ -42,7 +42,7 @@ import pytest
 from ttb_sim.cli import main
 from ttb_sim.config import load_scenario
 from ttb_sim.errors import ScenarioError
-from ttb_sim.sim.substructure_run import reference_refusal, SubstructureRun
+from ttb_sim.sim.substructure.standalone import reference_refusal, SubstructureRun
 
 COARSE = ['soil.block.lx=12', 'soil.block.ly=12', 'soil.mesh.h=0.8', 'soil.mesh.growth=1.5',
           'soil.mesh.h_max=2.5', 'piles.side=0.8', 'piles.length=6',

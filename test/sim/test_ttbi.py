@@ -24,7 +24,9 @@ from ttb_sim.errors import ScenarioError
 from ttb_sim.model.vehicle.dofs import dof
 import ttb_sim.model.wheel_rail as ct
 from ttb_sim.model.wheel_rail.profiles import contact_geometry_table
-from ttb_sim.sim.simulation import Simulation
+from ttb_sim.sim import Simulation
+from ttb_sim.sim.coupling.train_track.equilibrium import (irregularity_under_wheels,
+                                                          rail_under_wheels, wheel_geometry)
 
 SMALL = [('train.vehicle', 'car'), ('track.model', 'slab'), ('train.n_cars', 1),
          ('bridge.n_spans', 1), ('bearings.model', 'elastic'), ('train.start_position', 0.0)]
@@ -125,15 +127,15 @@ def test_contact_forces_satisfy_hertz_on_the_exact_track_response():
     for _ in sim.frames():
         pass
     x = sim.scenario.train.start_position + sim.speed * sim.n_steps * sim.dt + tt.contact_x
-    rows, _, dofs, _, interior = tt._rail_rows(x)
+    rows, _, dofs, _, interior = rail_under_wheels(tt, x)
     ue = np.append(tt.u, 0.0)
     # The rail head: its element's nodes' interpolation and its interior deflection.
     rail_z = (np.einsum('cwj,cwj->cw', rows[..., 2, :], ue[dofs])
               - np.einsum('cwj,cwj->cw', interior[..., 2, :], tt.force[..., :3]))
-    irr_z, _, _ = tt._irregularity(x)
+    irr_z, _, _ = irregularity_under_wheels(tt, x)
     wheel_z = (tt.q @ tt.h.T).reshape(tt.n_cars, 8, 4)[..., 2]
-    y_rel = tt.q[:, tt._wheelset_y] - tt._rail_y - tt._irregularity(x)[1]
-    _, _, height = tt._geometry(y_rel)
+    y_rel = tt.q[:, tt.wheelset_y] - tt.rail_y - irregularity_under_wheels(tt, x)[1]
+    _, _, height = wheel_geometry(tt, y_rel)
     delta = rail_z + irr_z - wheel_z + height
     hertz = ct.normal_force(delta, tt.g_hertz)
     # The tolerance is on the compression; the force follows through k_H.

@@ -19,11 +19,9 @@ import pytest
 import scipy.sparse as sp
 from ttb_sim.config import key_spec, load_scenario, Scenario
 from ttb_sim.fe.beam import point_rows
+from ttb_sim.sim import blas_threads, Newmark, Simulation, solver_variant, VARIANTS
 from ttb_sim.sim.coupling.base import girder_wheel_load
-from ttb_sim.sim.integrators.newmark import Newmark
-from ttb_sim.sim.lean import MovingLoad, point_rows_and_slopes
-from ttb_sim.sim.simulation import Simulation
-from ttb_sim.sim.variants import blas_threads, solver_variant, VARIANTS
+from ttb_sim.sim.coupling.girder_load import MovingLoad, point_rows_and_slopes
 
 
 def test_variants_are_the_choices_of_the_contract_key():

@@ -360,7 +360,7 @@ def interior_terms(xi: Any, length: Any, ea: Any, gj: Any, ei_y: Any, ei_z: Any,
 
     Elementwise arithmetic only, so the same function serves numpy arrays and,
     compiled, the scalars of the contact kernels
-    (:func:`ttb_sim.sim.contact_kernels.rail_rows`).
+    (:func:`ttb_sim.sim.coupling.train_track.rail_kernels.rail_rows`).
     """
     a = xi * length
     b = (1.0 - xi) * length

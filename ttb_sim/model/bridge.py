@@ -285,7 +285,7 @@ class PiledPier:
 
     The bridge meets it only through the bearings of its support. Monolithic: its
     coordinates q are DOFs of the structure (``block``); partitioned: it is
-    stepped beside the bridge (:mod:`ttb_sim.sim.piled_foundations`) and the
+    stepped beside the bridge (:mod:`ttb_sim.sim.substructure.piled_piers`) and the
     bearings of the support see its pier top as a moving support.
     """
 

@@ -30,8 +30,7 @@ from ttb_sim.sim.frames import Frame, Layout
 from ttb_sim.sim.integrators.newmark import Newmark
 from ttb_sim.sim.runner import make_runner, Runner
 from ttb_sim.sim.simulation import Simulation
-from ttb_sim.sim.substructure_run import (reference_refusal, substructure_dof_counts,
-                                          SubstructureRun)
+from ttb_sim.sim.substructure import reference_refusal, substructure_dof_counts, SubstructureRun
 from ttb_sim.sim.variants import blas_threads, solver_variant, VARIANTS
 
 __all__ = ['blas_threads', 'build_structure', 'build_vehicle', 'CostEstimate', 'estimate_cost',

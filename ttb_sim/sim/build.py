@@ -35,12 +35,9 @@ from ttb_sim.model.bridge import (assemble_structure, pier_section, rayleigh_coe
 from ttb_sim.model.foundation.operator import FoundationOperator
 from ttb_sim.model.irregularity import load_csv, synthesize, TrackIrregularity
 from ttb_sim.model.vehicle.train import Axles, MovingForces, MultibodyCars, QuarterCars, Vehicle
-from ttb_sim.sim.coupling.base import Coupling
-from ttb_sim.sim.coupling.moving_force import MovingForceCoupling
-from ttb_sim.sim.coupling.quarter_car import QuarterCarTrain
-from ttb_sim.sim.coupling.train_track import TrainTrackCoupling
-from ttb_sim.sim.integrators.protocol import Integrator
-from ttb_sim.sim.reduced_track import ReducedTrainTrackCoupling
+from ttb_sim.sim.coupling import (Coupling, MovingForceCoupling, QuarterCarTrain,
+                                  ReducedTrainTrackCoupling, TrainTrackCoupling)
+from ttb_sim.sim.integrators import Integrator
 
 LOG = logging.getLogger(__name__)
 
@@ -185,7 +182,8 @@ def build_coupling(scenario: Scenario, structure: Structure, vehicle: Vehicle,
         Lean load kernels (solver variants other than ``reference``).
     reduced : bool
         Multibody cars on the reduced track-bridge, detailed only around the
-        train (:mod:`ttb_sim.sim.reduced_track`); the other vehicles ignore it.
+        train (:mod:`ttb_sim.sim.coupling.train_track.reduced_track`); the other vehicles
+        ignore it.
 
     """
     if isinstance(vehicle, MultibodyCars):

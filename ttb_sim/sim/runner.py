@@ -16,7 +16,7 @@
 The run interface that the bag writer and the node step, and the one place that picks the model.
 
 :class:`Runner` is what :class:`~ttb_sim.sim.simulation.Simulation` (a train on
-the bridge) and :class:`~ttb_sim.sim.substructure_run.SubstructureRun` (a
+the bridge) and :class:`~ttb_sim.sim.substructure.standalone.SubstructureRun` (a
 pile-soil substructure alone under its load) both offer; :func:`make_runner`
 builds the right one for a scenario.
 """
@@ -29,7 +29,7 @@ from ttb_sim.config import Scenario
 from ttb_sim.sim.cost import CostEstimate, STEP_BUDGET
 from ttb_sim.sim.frames import Frame, Layout
 from ttb_sim.sim.simulation import Simulation
-from ttb_sim.sim.substructure_run import SubstructureRun
+from ttb_sim.sim.substructure.standalone import SubstructureRun
 
 __all__ = ['make_runner', 'Runner']
 

@@ -37,8 +37,8 @@ from ttb_sim.sim.build import (build_coupling, build_structure, build_vehicle, o
 from ttb_sim.sim.cost import CostEstimate, estimate_cost, STEP_BUDGET
 from ttb_sim.sim.frames import Frame, Layout
 from ttb_sim.sim.integrators.newmark import Newmark
-from ttb_sim.sim.piled_foundations import (InterfaceCheck, pile_coordinates, pile_outputs,
-                                           PiledFoundations, RigidDisplacement)
+from ttb_sim.sim.substructure.piled_piers import (InterfaceCheck, pile_coordinates, pile_outputs,
+                                                  PiledFoundations, RigidDisplacement)
 from ttb_sim.sim.variants import blas_threads, solver_variant
 
 log = logging.getLogger(__name__)

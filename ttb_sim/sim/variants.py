@@ -18,13 +18,15 @@ Solver variants (the scenario key ``solver.variant``) and the BLAS thread limit.
 A variant names how the stepping core solves: which factorisation of the
 constant matrices (:mod:`ttb_sim.fe.factorization`), whether the lean step is
 taken, and how many BLAS threads the run may use. ``reference`` is the
-validated path as it was written, with the process's BLAS threads untouched, so
-its bags stay bit-identical to those of earlier versions on the same machine.
+validated path as it was written, with the process's BLAS threads untouched:
+general SuperLU, the plain Newmark step, two track solves per step of the
+multibody cars (whose contact step every variant takes compiled; it agrees with
+the numpy step it replaced to round-off, ``test/sim/contact_oracle.py``).
 ``reduced`` is the one variant that changes the model, not only how it is
 solved: the track away from the train rides on the girder (an approximation
 with a stated range, README Benchmark); it is opt-in.
 A pile-soil substructure on its own (``scenario.substructure_only``,
-:mod:`ttb_sim.sim.substructure_run`) reads the same table: ``reference`` steps
+:mod:`ttb_sim.sim.substructure.standalone`) reads the same table: ``reference`` steps
 it fully implicit (one factorisation of every DOF, the validated Newmark
 method; a static load by a direct solve of each Newton iteration) and every
 other variant in the mixed scheme (explicit soil, implicit piles, cap and
@@ -59,10 +61,11 @@ class SolverVariant:
     """BLAS threads while building and stepping; None leaves the process setting."""
     reduced: bool = False
     """True to solve the slab track in detail only in a window around the train
-    (:mod:`ttb_sim.sim.reduced_track`); models without a slab track run as without."""
+    (:mod:`ttb_sim.sim.coupling.train_track.reduced_track`); models without a slab track
+    run as without."""
     pile_soil_scheme: str = 'mixed'
-    """Scheme of a pile-soil substructure run (:mod:`ttb_sim.sim.pile_soil`): 'implicit'
-    or 'mixed'."""
+    """Scheme of a pile-soil substructure run (:mod:`ttb_sim.sim.substructure.stepping`):
+    'implicit' or 'mixed'."""
 
     @property
     def pile_soil_factorization(self) -> str:

@@ -24,6 +24,7 @@ Track irregularity: the public face of the modules of this package.
 - :mod:`.variance`: the V8/V10 variance check of the synthesis.
 """
 
+from ttb_sim.model.irregularity._checks import GRID_SLACK
 from ttb_sim.model.irregularity.measured import CSV_COLUMNS, load_csv, MIN_CSV_ROWS, save_csv
 from ttb_sim.model.irregularity.profile import (IrregularitySample, RAIL_QUANTITIES,
                                                 TrackIrregularity)
@@ -38,6 +39,7 @@ __all__ = [
     'COMPONENTS',
     'CONTACT_SPACING',
     'CSV_COLUMNS',
+    'GRID_SLACK',
     'IrregularityLayer',
     'IrregularitySample',
     'MIN_CSV_ROWS',

@@ -15,14 +15,18 @@
 """
 Vehicle-structure couplings behind one protocol (:class:`Coupling`).
 
-Moving forces (no vehicle dynamics), quarter cars on the girders, and 42-DOF
-multibody cars on the slab track through wheel-rail contact.
+Moving forces (no vehicle dynamics, ``moving_force``), quarter cars on the
+girders (``quarter_car/``), and 42-DOF multibody cars on the slab track through
+wheel-rail contact (``train_track/``); beside them the protocol (``base``), the
+girder loads and rows of points on beams (``girder_load``) and the irregularity
+profile's interpolation as a kernel helper (``profile_kernels``).
 """
 
 from ttb_sim.sim.coupling.base import Coupling, girder_wheel_load, VehicleOutputs
 from ttb_sim.sim.coupling.moving_force import MovingForceCoupling
 from ttb_sim.sim.coupling.quarter_car import QuarterCarCoupling, QuarterCarTrain
-from ttb_sim.sim.coupling.train_track import TrainTrackCoupling
+from ttb_sim.sim.coupling.train_track import ReducedTrainTrackCoupling, TrainTrackCoupling
 
 __all__ = ['Coupling', 'girder_wheel_load', 'MovingForceCoupling', 'QuarterCarCoupling',
-           'QuarterCarTrain', 'TrainTrackCoupling', 'VehicleOutputs']
+           'QuarterCarTrain', 'ReducedTrainTrackCoupling', 'TrainTrackCoupling',
+           'VehicleOutputs']

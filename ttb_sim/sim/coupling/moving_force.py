@@ -21,8 +21,8 @@ import numpy as np
 from ttb_sim.model.bridge import Structure
 from ttb_sim.model.vehicle.train import MovingForces
 from ttb_sim.sim.coupling.base import FreeDofState, girder_wheel_load, VehicleOutputs
+from ttb_sim.sim.coupling.girder_load import MovingLoad
 from ttb_sim.sim.integrators.protocol import Integrator
-from ttb_sim.sim.lean import MovingLoad
 
 __all__ = ['MovingForceCoupling']
 
@@ -40,8 +40,9 @@ class MovingForceCoupling(FreeDofState):
     integrator : Integrator
         The structure's integrator.
     lean : bool
-        Evaluate the load with the lean kernel (:class:`~ttb_sim.sim.lean.MovingLoad`),
-        equal to round-off, instead of the general girder lookup.
+        Evaluate the load with the lean kernel
+        (:class:`~ttb_sim.sim.coupling.girder_load.MovingLoad`), equal to round-off,
+        instead of the general girder lookup.
 
     """
 

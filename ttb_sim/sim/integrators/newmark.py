@@ -21,7 +21,7 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as sla
 from ttb_sim.fe.compiled import sparse_arrays
 from ttb_sim.fe.factorization import factorize
-from ttb_sim.sim import kernels
+from ttb_sim.sim.integrators.newmark_kernels import KERNELS
 
 
 class Newmark:
@@ -46,7 +46,7 @@ class Newmark:
         Lean step: :meth:`history` writes into one preallocated vector (valid
         until its next call) and :meth:`effective_load` applies M and C as one
         stacked sparse matrix (one mat-vec); equal to round-off. With numba,
-        history and finish are compiled loops (:mod:`ttb_sim.sim.kernels`)
+        history and finish are compiled loops (:mod:`ttb_sim.sim.integrators.newmark_kernels`)
         with the same arithmetic, and so is the stacked mat-vec (each row summed
         in scipy's order; unsigned indices make it twice as fast as scipy's).
         The lean step also solves a long effective matrix as two halves on two
@@ -81,9 +81,9 @@ class Newmark:
         """Load added to every effective right-hand side, (DOFs (unique), values): the
         bearing forces of partitioned substructures on the girders, set before each step
         (None: none)."""
-        self._history_kernel = kernels.compiled('history') if lean else None
-        self._finish_kernel = kernels.compiled('finish') if lean else None
-        self._load_kernel = kernels.compiled('effective_load') if lean else None
+        self._history_kernel = KERNELS.compiled('history') if lean else None
+        self._finish_kernel = KERNELS.compiled('finish') if lean else None
+        self._load_kernel = KERNELS.compiled('effective_load') if lean else None
 
     def history(self, u: np.ndarray, v: np.ndarray,
                 a: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

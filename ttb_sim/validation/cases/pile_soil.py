@@ -18,7 +18,7 @@ Pile-soil validation cases V11-V16 (VALIDATION.md) and the mesh convergence chec
 Each case builds its substructure from the records users give
 (:mod:`ttb_sim.model.foundation.records` -> :func:`~ttb_sim.model.foundation.substructure.build`)
 and takes the computed number from the model's operators or from the same
-stepping code users run (:mod:`ttb_sim.sim.pile_soil`); the references come
+stepping code users run (:mod:`ttb_sim.sim.substructure.stepping`); the references come
 from :mod:`ttb_sim.validation.references.pile_soil`, which shares no code with
 them.
 
@@ -67,8 +67,7 @@ from ttb_sim.model.foundation.records import (BlockSize, EQUAL_AREA_SIDE, MeshSi
                                               Substructure)
 from ttb_sim.model.foundation.substructure import build, PileSoilModel
 from ttb_sim.sim.frames import Frame
-from ttb_sim.sim.pile_soil import observe, states, static_solve
-from ttb_sim.sim.substructure_run import SubstructureRun
+from ttb_sim.sim.substructure import observe, states, static_solve, SubstructureRun
 from ttb_sim.validation.references.pile_soil import (hyperbola_stress, hyperbola_tangent,
                                                      layered_pile_stiffness,
                                                      quarter_wavelength_frequencies,

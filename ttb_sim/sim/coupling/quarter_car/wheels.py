@@ -30,7 +30,7 @@ is computed once, so a step needs two single-right-hand-side solves and a small
 gather instead of the m + 1 right-hand sides: the same equations, in another order
 of operations (equal to rounding). With a lean integrator (every solver variant but
 ``reference``) and numba installed, that step runs in the compiled kernels of
-:mod:`ttb_sim.sim.quarter_car_kernels`, again equal to rounding; the ``reference``
+:mod:`ttb_sim.sim.coupling.quarter_car.wheel_kernels`, again equal to rounding; the ``reference``
 variant keeps the numpy path, bit for bit.
 """
 
@@ -42,11 +42,10 @@ import numpy as np
 
 from ttb_sim.model.bridge import GirderLine, Structure
 from ttb_sim.model.constants import GRAVITY
-from ttb_sim.model.irregularity import TrackIrregularity
-from ttb_sim.model.irregularity._checks import GRID_SLACK
+from ttb_sim.model.irregularity import GRID_SLACK, TrackIrregularity
 from ttb_sim.model.vehicle.train import QuarterCars
-from ttb_sim.sim import quarter_car_kernels
 from ttb_sim.sim.coupling.base import FreeDofState, girder_wheel_load, VehicleOutputs
+from ttb_sim.sim.coupling.quarter_car import wheel_kernels
 from ttb_sim.sim.integrators.protocol import Integrator
 
 DENSE_GIRDER_LIMIT = 3000
@@ -94,7 +93,7 @@ class QuarterCarCoupling:
         if compiled is None:
             compiled = bool(getattr(integrator, 'lean', False))
         self.compiled = (compiled and self._green is not None
-                         and quarter_car_kernels.available())
+                         and wheel_kernels.available())
         """True when :meth:`step` runs the compiled kernels."""
         self.element = np.zeros(n, dtype=np.intp)
         """Element under each wheel at the latest compiled step."""
@@ -108,7 +107,7 @@ class QuarterCarCoupling:
             self._w, self._p = np.zeros((n, 4)), np.zeros((n, 4))
             self._b, self._e = np.zeros(n), np.zeros(n)
             self._hs_v, self._hs_a = np.zeros(n), np.zeros(n)
-            found = (quarter_car_kernels.compiled(name) for name in (
+            found = (wheel_kernels.KERNELS.compiled(name) for name in (
                 'wheel_terms', 'green_correction', 'update_cars'))
             self._kernels = tuple(k for k in found if k is not None)
 
@@ -305,7 +304,7 @@ class QuarterCarTrain(FreeDofState):
         self._zero = np.zeros(n_free)
         n = cars.axles.count
         self._r = (np.zeros(n), np.zeros(n), np.zeros(n))
-        self._profile_kernel = (quarter_car_kernels.compiled('centreline_profile')
+        self._profile_kernel = (wheel_kernels.KERNELS.compiled('centreline_profile')
                                 if self.kernel.compiled and irregularity is not None else None)
 
     def _profile(self, positions: np.ndarray

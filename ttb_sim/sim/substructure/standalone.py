@@ -28,7 +28,7 @@ Solver: ``solver.variant`` as :mod:`ttb_sim.sim.variants` maps it.
 factorised system; a static load by a direct solve of each Newton iteration),
 the simple validated path, refused before anything is built when its factor
 would not fit in memory (:func:`reference_refusal`). Every other variant runs
-the mixed scheme of :mod:`ttb_sim.sim.pile_soil` (explicit soil and boundary,
+the mixed scheme of :mod:`ttb_sim.sim.substructure.stepping` (explicit soil and boundary,
 implicit piles, cap and interface; a static load by preconditioned conjugate
 gradients), the pile block factorised by the variant's method.
 
@@ -55,8 +55,8 @@ from ttb_sim.model.foundation.substructure import (build, CAP, PILE, PileSoilMod
                                                    SOIL)
 from ttb_sim.sim.cost import CostEstimate, STEP_BUDGET
 from ttb_sim.sim.frames import Frame, Layout
-from ttb_sim.sim.pile_soil import (implicit_dofs, initial_state, mixed_stable_step, observe,
-                                   PartitionedNewmark, State, static_solve)
+from ttb_sim.sim.substructure.stepping import (implicit_dofs, initial_state, mixed_stable_step,
+                                               observe, PartitionedNewmark, State, static_solve)
 from ttb_sim.sim.variants import blas_threads, solver_variant, VARIANTS
 
 __all__ = ['SubstructureRun', 'AUTO_STEPS_PER_PERIOD', 'AUTO_PERIODS', 'reference_refusal',

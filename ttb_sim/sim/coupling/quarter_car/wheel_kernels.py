@@ -43,24 +43,13 @@ directory is writable).
 
 from __future__ import annotations
 
-from typing import Any, Callable
-
 import numpy as np
-from ttb_sim.sim import kernels
-from ttb_sim.sim.contact_kernels import quintic
+
+from ttb_sim.sim.coupling.profile_kernels import quintic
+from ttb_sim.sim.kernel_registry import KernelTable
 
 HELPERS = ('quintic',)
-"""Functions the kernels call: :func:`ttb_sim.sim.kernels.jit` compiles them first."""
-
-
-def compiled(name: str) -> Callable[..., Any] | None:
-    """Return the compiled quarter-car kernel ``name`` (:func:`ttb_sim.sim.kernels.jit`)."""
-    return kernels.jit(_KERNELS[name])
-
-
-def available() -> bool:
-    """Tell whether every quarter-car kernel is compiled (compiling them on first call)."""
-    return all(compiled(name) is not None for name in _KERNELS)
+"""Functions the kernels call: :func:`ttb_sim.fe.compiled.jit` compiles them first."""
 
 
 def _centreline_profile(x: np.ndarray, x_start: float, dx: float, values: np.ndarray,
@@ -227,6 +216,14 @@ def _update_cars(u: np.ndarray, dofs: np.ndarray, w: np.ndarray, p: np.ndarray,
         contact[i] = ww + b[i]
 
 
-_KERNELS: dict[str, Callable[..., Any]] = {
+KERNELS = KernelTable({
     'centreline_profile': _centreline_profile, 'wheel_terms': _wheel_terms,
-    'green_correction': _green_correction, 'update_cars': _update_cars}
+    'green_correction': _green_correction, 'update_cars': _update_cars})
+"""The quarter cars' kernels."""
+
+
+def available() -> bool:
+    """Tell whether every quarter-car kernel is compiled (compiling them on first call)."""
+    return all(KERNELS.compiled(name) is not None
+               for name in ('centreline_profile', 'wheel_terms', 'green_correction',
+                            'update_cars'))

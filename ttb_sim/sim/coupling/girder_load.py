@@ -13,9 +13,12 @@
 # limitations under the License.
 
 """
-Lean kernels of the fast solver variants (``solver.variant`` other than ``reference``).
+Loads and rows of points on beams, for the lean solver variants.
 
-Each kernel computes what a general routine of the reference path computes, with
+:class:`MovingLoad` gives the free-DOF load of constant axle forces on the
+girders (moving forces, quarter cars) and :func:`point_rows_and_slopes` the
+rows of points on a beam with their slopes (the rail head under the wheels).
+Each computes what a general routine of the reference path computes, with
 fewer numpy calls and no full-size temporaries, for the one case a time step
 needs; results agree with the reference to round-off. Each was kept because a
 profile showed it wins (README, Benchmark).
@@ -27,7 +30,7 @@ import numpy as np
 
 from ttb_sim.fe.beam import hermite, offset_rows, V_DOFS, W_DOFS
 from ttb_sim.model.bridge import GirderLine
-from ttb_sim.sim import kernels
+from ttb_sim.sim.kernel_registry import KernelTable
 
 _W_SIGN = np.array([1.0, -1.0, 1.0, -1.0])
 """Signs that turn Hermite functions into the (uz, ry) row (ry = -w')."""
@@ -82,8 +85,8 @@ class MovingLoad:
     lookup and then gathers the free DOFs; this evaluates the cubic Hermite
     rows inline and sums straight into the free DOFs (measured 68 -> 29 us per
     step on ten_span_train, 32 axles). With numba the free-DOF load is one
-    compiled loop into a preallocated vector (:func:`ttb_sim.sim.kernels.moving_load`,
-    the same arithmetic). The full-DOF load (support reactions) is only needed
+    compiled loop into a preallocated vector (:func:`moving_load`, the same
+    arithmetic). The full-DOF load (support reactions) is only needed
     at output frames: :meth:`full`.
 
     Parameters
@@ -109,7 +112,7 @@ class MovingLoad:
         self._forces = np.asarray(forces, dtype=float)
         self._n_free = n_free
         self._n_full = n_full
-        self._kernel = kernels.compiled('moving_load')
+        self._kernel = KERNELS.compiled('moving_load')
         self._out = np.zeros(n_free + 1)
 
     def __call__(self, positions: np.ndarray) -> np.ndarray:
@@ -156,3 +159,38 @@ class MovingLoad:
         rows[:, 3] = (xi3 - xi2) * -h
         rows *= weight[:, None]
         return element, rows
+
+
+def moving_load(positions: np.ndarray, forces: np.ndarray, h: float, n_el: int,
+                length: float, dofs: np.ndarray, out: np.ndarray) -> None:
+    """
+    Sum the consistent load of vertical axle forces on the girder into ``out``.
+
+    The same arithmetic as :meth:`MovingLoad._rows` followed
+    by ``np.bincount``, axle by axle.
+    """
+    out[:] = 0.0
+    for i in range(positions.shape[0]):
+        x = positions[i]
+        s = x / h
+        e = min(max(np.floor(s), 0.0), n_el - 1)
+        element = int(e)
+        xi = min(max(s - e, 0.0), 1.0)
+        if x >= 0.0 and x <= length:
+            weight = -forces[i]
+        else:
+            weight = 0.0
+        xi2 = xi * xi
+        xi3 = xi2 * xi
+        r0 = (1.0 - 3.0 * xi2 + 2.0 * xi3) * weight
+        r1 = ((xi3 - 2.0 * xi2 + xi) * -h) * weight
+        r2 = (3.0 * xi2 - 2.0 * xi3) * weight
+        r3 = ((xi3 - xi2) * -h) * weight
+        out[dofs[element, 0]] += r0
+        out[dofs[element, 1]] += r1
+        out[dofs[element, 2]] += r2
+        out[dofs[element, 3]] += r3
+
+
+KERNELS = KernelTable({'moving_load': moving_load})
+"""The compiled girder load."""

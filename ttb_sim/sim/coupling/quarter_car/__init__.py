@@ -1,0 +1,23 @@
+# Copyright 2026 The ttb_sim Authors
+#
+# Licensed under the Apache License, Version 2.0 (the "License");
+# you may not use this file except in compliance with the License.
+# You may obtain a copy of the License at
+#
+#     http://www.apache.org/licenses/LICENSE-2.0
+#
+# Unless required by applicable law or agreed to in writing, software
+# distributed under the License is distributed on an "AS IS" BASIS,
+# WITHOUT WARRANTIES OR CONDITIONS OF ANY KIND, either express or implied.
+# See the License for the specific language governing permissions and
+# limitations under the License.
+
+"""
+Quarter cars (a sprung mass on a spring-dashpot over a massless wheel) on the girders.
+
+``wheels`` holds the couplings, ``wheel_kernels`` their compiled loops.
+"""
+
+from ttb_sim.sim.coupling.quarter_car.wheels import QuarterCarCoupling, QuarterCarTrain
+
+__all__ = ['QuarterCarCoupling', 'QuarterCarTrain']
