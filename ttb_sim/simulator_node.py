@@ -94,7 +94,7 @@ from ttb_sim.node.message_cache import MessageCache
 from ttb_sim.node.passage import FrameSink, Tick
 from ttb_sim.node.publishing import PublishLoop
 from ttb_sim.node.stepper import Stepper
-from ttb_sim.sim.frames import Frame, Layout
+from ttb_sim.sim import Frame, Layout
 from visualization_msgs.msg import Marker, MarkerArray
 
 STEP_BUDGET = 0.02

@@ -38,7 +38,7 @@ from ttb_sim.commands.compare import flatten
 from ttb_sim.commands.report import bag_metrics
 from ttb_sim.commands.streams import load_streams
 from ttb_sim.io.topics import topic_table
-from ttb_sim.sim.frames import Layout
+from ttb_sim.sim import Layout
 
 import synthetic_bag as sb   # noqa: I100 - the helper next to this file
 

@@ -37,8 +37,7 @@ from ttb_sim.io import reader as reader_module
 from ttb_sim.io.bag import BagRecorder, typestore
 from ttb_sim.io.reader import bag_topics, read_bag, SUPPORTED_TYPES, TopicArrays
 from ttb_sim.io.topics import topic_table
-from ttb_sim.sim.frames import Frame
-from ttb_sim.sim.simulation import Simulation
+from ttb_sim.sim import Frame, Simulation
 
 NS = '/ttb_sim'
 

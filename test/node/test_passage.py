@@ -25,7 +25,7 @@ from ttb_sim.io.bag import BagRecorder
 from ttb_sim.io.topics import topic_table
 from ttb_sim.node.parameters import initial_values, parameter_table
 from ttb_sim.node.passage import ERROR, OK, PassageController
-from ttb_sim.sim.frames import Frame
+from ttb_sim.sim import Frame
 
 
 class FakeClock:

@@ -37,8 +37,7 @@ from ttb_sim.config import load_scenario, Scenario
 from ttb_sim.errors import SimulationError
 from ttb_sim.io.bag import BagRecorder, check_destination, default_bag_path, make_parents
 from ttb_sim.io.topics import PeakTracker, topic_table
-from ttb_sim.sim.cost import CostEstimate, STEP_BUDGET
-from ttb_sim.sim.runner import make_runner, Runner
+from ttb_sim.sim import CostEstimate, make_runner, Runner, STEP_BUDGET
 
 log = logging.getLogger(__name__)
 
@@ -113,7 +112,7 @@ def run_to_bag(scenario: Scenario, out: Path, storage: str = 'mcap',
     progress : callable, optional
         Called with the number of frames written since the last call.
     simulation : Runner, optional
-        An already built model of ``scenario`` (:func:`~ttb_sim.sim.runner.make_runner`).
+        An already built model of ``scenario`` (:func:`~ttb_sim.sim.make_runner`).
     should_stop : callable, optional
         Polled between frames; when it returns True the run stops cleanly with
         status 'interrupted' (signal handlers set such a flag, so that no
@@ -213,7 +212,7 @@ def run(scenario: str | Path, *, out: Path | None = None, storage: str = 'mcap',
     speed_kmh, duration
         Shortcuts for ``train.speed_kmh`` and ``solver.duration``.
     force
-        Run even above the step budget (:data:`~ttb_sim.sim.cost.STEP_BUDGET`).
+        Run even above the step budget (:data:`~ttb_sim.sim.STEP_BUDGET`).
 
     Raises
     ------

@@ -85,8 +85,7 @@ def run_case(spec: CaseSpec) -> dict[str, Any]:
     from ttb_sim.commands.run import run_to_bag
     from ttb_sim.commands.streams import load_streams
     from ttb_sim.config import load_scenario
-    from ttb_sim.sim.simulation import Simulation
-    from ttb_sim.sim.cost import STEP_BUDGET
+    from ttb_sim.sim import Simulation, STEP_BUDGET
 
     start = time.perf_counter()
     folder = Path(spec.folder)

@@ -30,7 +30,7 @@ from rosbags.typesys import get_typestore, Stores
 from ttb_sim.errors import ScenarioError
 from ttb_sim.inputs import shown
 from ttb_sim.io.topics import NAMESPACE, Topic
-from ttb_sim.sim.frames import Frame
+from ttb_sim.sim import Frame
 
 STORAGES = {'mcap': StoragePlugin.MCAP, 'sqlite3': StoragePlugin.SQLITE3}
 """Storage back-ends by their rosbag2 plugin names."""

@@ -16,7 +16,7 @@
 """
 Passage control: the simulation stepping behind the live node, paced and recorded.
 
-:class:`PassageController` owns a :class:`~ttb_sim.sim.runner.Runner` (a train
+:class:`PassageController` owns a :class:`~ttb_sim.sim.Runner` (a train
 simulation, or a pile-soil substructure alone under its load),
 steps it paced by the real-time factor, hands every frame to a recorder (a
 :class:`FrameSink`) and the frames due for live publishing (``publish_rate_hz``
@@ -40,9 +40,7 @@ from ttb_sim.config import Scenario
 from ttb_sim.errors import DivergenceError, TtbSimError
 from ttb_sim.node.parameters import (IRREGULARITY_KEYS, normalize_value, parameter_table,
                                      SCENARIO_KEYS, scenario_with)
-from ttb_sim.sim.frames import Frame, Layout
-from ttb_sim.sim.runner import make_runner, Runner
-from ttb_sim.sim.simulation import Simulation
+from ttb_sim.sim import Frame, Layout, make_runner, Runner, Simulation
 
 log = logging.getLogger(__name__)
 
