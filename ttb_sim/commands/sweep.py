@@ -45,10 +45,10 @@ import threading
 import time
 from typing import Any, Callable, Iterator, Sequence
 
-from ttb_sim.commands.report_html import write_json
 from ttb_sim.commands.sweep_case import case_row, CaseSpec, is_finished, run_case
 from ttb_sim.config import load_scenario
 from ttb_sim.errors import ScenarioError
+from ttb_sim.report.output import write_json
 
 log = logging.getLogger(__name__)
 
@@ -297,7 +297,7 @@ def sweep(scenario: str, *, speeds_kmh: str, seeds: int | None = None,
             signal.signal(signum, handler)
     rows = [case_row(records[c.name]) for c in cases if c.name in records]
     _write_csv(target / 'sweep.csv', rows)
-    from ttb_sim.commands.sweep_figures import sweep_figures
+    from ttb_sim.report.sweep_figures import sweep_figures
     figures = sweep_figures(rows, target)
     failed = [r['case'] for r in rows if r['status'] != 'ok']
     print(f'{target}: {len(cases)} cases ({len(done)} skipped as finished, '
