@@ -28,12 +28,12 @@ import argparse
 import logging
 import os
 from pathlib import Path
-import signal
 import sys
 import threading
 from typing import Sequence
 
 from ttb_sim import __version__
+from ttb_sim.commands.signals import SignalHandlers, stop_now
 from ttb_sim.errors import ModelError, ScenarioError, TtbSimError
 
 log = logging.getLogger('ttb_sim')
@@ -132,23 +132,12 @@ def _parser() -> argparse.ArgumentParser:
     return p
 
 
-def _stop_now(signum: int, frame: object) -> None:
-    """Before a verb takes over the signals nothing is written: end at once, one line."""
-    name = 'SIGTERM' if signum == signal.SIGTERM else 'SIGINT'
-    os.write(2, f'ttb-sim: stopped by {name}\n'.encode())
-    os._exit(128 + signum)
-
-
 def main(argv: Sequence[str] | None = None) -> int:
     """Run the command line; return the exit code."""
-    previous = {}
-    if threading.current_thread() is threading.main_thread():
-        previous = {sig: signal.signal(sig, _stop_now) for sig in (signal.SIGINT, signal.SIGTERM)}
-    try:
+    with SignalHandlers() as handlers:
+        if threading.current_thread() is threading.main_thread():
+            handlers.install(stop_now)
         return _main(argv)
-    finally:
-        for sig, handler in previous.items():
-            signal.signal(sig, handler)
 
 
 def entry() -> None:
@@ -162,8 +151,7 @@ def entry() -> None:
     ``os._exit`` once the verb has returned and the output is flushed.
     """
     if threading.current_thread() is threading.main_thread():
-        for sig in (signal.SIGINT, signal.SIGTERM):
-            signal.signal(sig, _stop_now)
+        SignalHandlers().install(stop_now)   # never restored: see above
     try:
         code = _main(sys.argv[1:])
     except SystemExit as exc:  # argparse's own exits (usage errors, --help)

@@ -25,14 +25,14 @@ from __future__ import annotations
 from dataclasses import dataclass
 import json
 import logging
-import os
 from pathlib import Path
 import signal
 import sys
 import time
-from typing import Any, Callable, NoReturn, Sequence
+from typing import Any, Callable, Sequence
 
 from ttb_sim import __version__
+from ttb_sim.commands.signals import signal_name, SignalHandlers, StopFlag
 from ttb_sim.config import load_scenario, Scenario
 from ttb_sim.errors import SimulationError
 from ttb_sim.io.bag import BagRecorder, check_destination, default_bag_path, make_parents
@@ -42,45 +42,6 @@ from ttb_sim.sim import CostEstimate, make_runner, Runner, STEP_BUDGET
 log = logging.getLogger(__name__)
 
 EXIT_OK, EXIT_FAILURE = 0, 1
-
-
-class StopFlag:
-    """
-    Signal handler for SIGINT / SIGTERM, installed before set-up.
-
-    During set-up (:attr:`setup` True) nothing has been written, so a signal
-    ends the process at once with one line on stderr and exit 128 + signal
-    (:func:`exit_on_signal`): no exception has to unwind through half-imported
-    extension modules or a factorisation. Once recording starts (:attr:`setup`
-    False) a signal only sets the flag, which the run loop polls between
-    frames, so that no message is ever half-written.
-    """
-
-    def __init__(self) -> None:
-        self.signal: int | None = None
-        self.setup = True
-
-    def __call__(self, signum: int, frame: object) -> None:
-        if self.setup:
-            exit_on_signal(signum, 'during set-up; nothing written')
-        self.signal = signum
-
-    def __bool__(self) -> bool:
-        return self.signal is not None
-
-
-def exit_on_signal(signum: int, detail: str) -> NoReturn:
-    """Write 'ttb-sim: stopped by SIGNAME <detail>' to stderr; end the process (128 + signum)."""
-    os.write(2, f'ttb-sim: stopped by {signal_name(signum)} {detail}\n'.encode())
-    os._exit(128 + signum)
-
-
-def signal_name(signum: int | None) -> str:
-    """Return 'SIGINT', 'SIGTERM', ... for a signal number."""
-    try:
-        return signal.Signals(signum).name if signum else 'a signal'
-    except ValueError:
-        return f'signal {signum}'
 
 
 @dataclass
@@ -223,7 +184,8 @@ def run(scenario: str | Path, *, out: Path | None = None, storage: str = 'mcap',
     """
     start = time.perf_counter()
     stop = StopFlag()
-    previous = {sig: signal.signal(sig, stop) for sig in (signal.SIGINT, signal.SIGTERM)}
+    handlers = SignalHandlers()
+    handlers.install(stop)
     bar = None
     try:
         loaded, out, simulation = _set_up(scenario, out, storage, overrides, speed_kmh,
@@ -240,8 +202,7 @@ def run(scenario: str | Path, *, out: Path | None = None, storage: str = 'mcap',
                             simulation=simulation, should_stop=stop.__bool__,
                             setup_time=time.perf_counter() - start, estimate=estimate)
     finally:
-        for sig, handler in previous.items():
-            signal.signal(sig, handler)
+        handlers.restore()
         if bar is not None:
             bar.close()
     s = result.summary
