@@ -22,7 +22,9 @@ copies values into and out of rclpy objects.
   schema), validation and normalisation of values, start-up values, the
   scenario of a passage;
 - :mod:`~ttb_sim.node.passage`: the :class:`PassageController` that steps,
-  paces, records and reports passages (ticks, frame sink, diagnostics);
+  paces, records and reports passages (ticks, frame sink);
+- :mod:`~ttb_sim.node.diagnostics`: what ``/diagnostics`` says, as plain data
+  (the report, the stepping meter, the level of a passage state);
 - :mod:`~ttb_sim.node.stepper`: the stepping thread (:class:`Stepper`) that builds
   the model, opens, writes and closes the bag and steps, off the executor;
 - :mod:`~ttb_sim.node.publishing`: the publishing thread (:class:`PublishLoop`)
@@ -30,13 +32,13 @@ copies values into and out of rclpy objects.
 - :mod:`~ttb_sim.node.markers`: the structure and train markers as plain boxes.
 """
 
+from ttb_sim.node.diagnostics import DiagnosticsReport, ERROR, frame_values, OK, WARN
 from ttb_sim.node.markers import Box, markers, MarkerSet, model_markers, train_markers
 from ttb_sim.node.parameters import (DEFAULT_SCENARIO, initial_values, IRREGULARITY_KEYS,
                                      NodeParameter, normalize_value, parameter_table,
                                      SCENARIO_KEYS, scenario_with, validate_changes,
                                      validate_parameter)
-from ttb_sim.node.passage import (DiagnosticsReport, ERROR, frame_values, FrameSink, OK,
-                                  PassageController, Tick, WARN)
+from ttb_sim.node.passage import FrameSink, PassageController, Tick, TrainRun
 from ttb_sim.node.publishing import PublishLoop, PublishStats
 from ttb_sim.node.stepper import Stepper, StepperStatus
 
@@ -64,6 +66,7 @@ __all__ = [
     'Stepper',
     'StepperStatus',
     'Tick',
+    'TrainRun',
     'train_markers',
     'validate_changes',
     'validate_parameter',
