@@ -20,13 +20,16 @@ returns and the shell copies into a ``diagnostic_msgs/msg/DiagnosticStatus``;
 :class:`StepMeter` keeps the stepping totals (simulated time, steps, stepping wall
 and CPU time) and gives their window since the previous report;
 :func:`passage_level` rates the passage state; :func:`frame_values` gives a frame's
-headline values.
+headline values; :func:`diagnostic_array` copies a report into a
+``diagnostic_msgs/msg/DiagnosticArray`` of the message classes it is given.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Any
 
+from ttb_sim.io.topics import MessageTypes
 from ttb_sim.sim import Frame
 
 OK, WARN, ERROR = 0, 1, 2
@@ -188,3 +191,28 @@ def frame_values(frame: Frame) -> list[tuple[str, str]]:
     for k, mid in enumerate(frame.midspan):
         out.append((f'span{k + 1:02d} midspan z (m)', f'{float(mid[2]):.6g}'))
     return out
+
+
+def diagnostic_array(types: MessageTypes, report: DiagnosticsReport, name: str,
+                     hardware_id: str, stamp: Any) -> Any:
+    """
+    Copy a report into a ``diagnostic_msgs/msg/DiagnosticArray`` of one status.
+
+    Parameters
+    ----------
+    types : callable
+        Maps a ROS type name to its message class (rclpy's in the node).
+    report : DiagnosticsReport
+        Level, message and key/value pairs.
+    name, hardware_id : str
+        The status's name and hardware id.
+    stamp : builtin_interfaces/msg/Time
+        The header stamp.
+
+    """
+    key_value = types('diagnostic_msgs/msg/KeyValue')
+    status = types('diagnostic_msgs/msg/DiagnosticStatus')(
+        level=bytes([report.level]), name=name, message=report.message,
+        hardware_id=hardware_id, values=[key_value(key=k, value=v) for k, v in report.values])
+    header = types('std_msgs/msg/Header')(stamp=stamp, frame_id='')
+    return types('diagnostic_msgs/msg/DiagnosticArray')(header=header, status=[status])
