@@ -340,6 +340,54 @@ def _line_at(x: NDArray[np.float64], y: NDArray[np.float64], width: int,
     return (sy - slope * sx) / width + slope * at
 
 
+def _positive_band(freq: NDArray[np.float64], psd: NDArray[np.float64],
+                   band: tuple[float, float] | None
+                   ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """Return f and p inside the band (without a zero-frequency bin), both > 0 there."""
+    index = _band(freq, band)
+    if band is None:
+        index = index[freq[index] > 0.0]
+    sel_f, sel_p = freq[index], psd[index]
+    if sel_f[0] <= 0.0 or np.any(sel_p <= 0.0):
+        raise ScenarioError(
+            f'f and p must be > 0 inside band {band!r}, got f from {sel_f[0]!r} Hz and '
+            f'minimum p {sel_p.min()!r}')
+    return sel_f, sel_p
+
+
+def _window_width(window_bins: int | None, count: int, band: tuple[float, float] | None) -> int:
+    """Return the bins fitted on each side of a break (checked against the band's bins)."""
+    if window_bins is None:
+        width = max(MIN_WINDOW_BINS, count // 8)
+    elif isinstance(window_bins, bool) or not isinstance(window_bins, (int, np.integer)) \
+            or window_bins < MIN_WINDOW_BINS:
+        raise ScenarioError(
+            f'window_bins must be an integer >= {MIN_WINDOW_BINS}, got {window_bins!r}')
+    else:
+        width = int(window_bins)
+    if count < 2 * width:
+        raise ScenarioError(
+            f'band {band!r} must hold at least 2 * window_bins = {2 * width} bins, '
+            f'got {count}')
+    return width
+
+
+def _level_steps(sel_f: NDArray[np.float64], sel_p: NDArray[np.float64], width: int
+                 ) -> tuple[NDArray[np.intp], NDArray[np.float64]]:
+    """Return the candidate breaks and the level step (decades) of the two fits at each."""
+    count = sel_f.size
+    log_f = np.log10(sel_f)
+    centre = log_f.mean()
+    x = log_f - centre
+    y = np.log10(sel_p)
+    # Break k lies between bins k - 1 and k, k = width .. count - width.
+    breaks = np.arange(width, count - width + 1)
+    x_break = np.log10(0.5 * (sel_f[breaks - 1] + sel_f[breaks])) - centre
+    below = _line_at(x, y, width, np.pad(x_break, (0, width)))[breaks - width]
+    above = _line_at(x, y, width, np.pad(x_break, (width, 0)))[breaks]
+    return breaks, above - below
+
+
 def level_change_frequency(f: ArrayLike, p: ArrayLike,
                            band: tuple[float, float] | None = None,
                            window_bins: int | None = None,
@@ -403,37 +451,9 @@ def level_change_frequency(f: ArrayLike, p: ArrayLike,
     freq, psd = _spectrum(f, p)
     if direction not in _DIRECTIONS:
         raise ScenarioError(f"direction must be one of 'either', 'down', 'up', got {direction!r}")
-    index = _band(freq, band)
-    if band is None:
-        index = index[freq[index] > 0.0]
-    sel_f, sel_p = freq[index], psd[index]
-    if sel_f[0] <= 0.0 or np.any(sel_p <= 0.0):
-        raise ScenarioError(
-            f'f and p must be > 0 inside band {band!r}, got f from {sel_f[0]!r} Hz and '
-            f'minimum p {sel_p.min()!r}')
-    count = sel_f.size
-    if window_bins is None:
-        width = max(MIN_WINDOW_BINS, count // 8)
-    elif isinstance(window_bins, bool) or not isinstance(window_bins, (int, np.integer)) \
-            or window_bins < MIN_WINDOW_BINS:
-        raise ScenarioError(
-            f'window_bins must be an integer >= {MIN_WINDOW_BINS}, got {window_bins!r}')
-    else:
-        width = int(window_bins)
-    if count < 2 * width:
-        raise ScenarioError(
-            f'band {band!r} must hold at least 2 * window_bins = {2 * width} bins, '
-            f'got {count}')
-    log_f = np.log10(sel_f)
-    centre = log_f.mean()
-    x = log_f - centre
-    y = np.log10(sel_p)
-    # Break k lies between bins k - 1 and k, k = width .. count - width.
-    breaks = np.arange(width, count - width + 1)
-    x_break = np.log10(0.5 * (sel_f[breaks - 1] + sel_f[breaks])) - centre
-    below = _line_at(x, y, width, np.pad(x_break, (0, width)))[breaks - width]
-    above = _line_at(x, y, width, np.pad(x_break, (width, 0)))[breaks]
-    step = above - below
+    sel_f, sel_p = _positive_band(freq, psd, band)
+    width = _window_width(window_bins, sel_f.size, band)
+    breaks, step = _level_steps(sel_f, sel_p, width)
     if direction == 'down':
         j = int(np.argmin(step))
     elif direction == 'up':

@@ -36,7 +36,7 @@ from ttb_sim.commands.signals import signal_name, SignalHandlers, StopFlag
 from ttb_sim.config import load_scenario, Scenario
 from ttb_sim.errors import SimulationError
 from ttb_sim.io.bag import BagRecorder, check_destination, default_bag_path, make_parents
-from ttb_sim.io.topics import PeakTracker, topic_table
+from ttb_sim.io.topics import PeakTracker, Topic, topic_table
 from ttb_sim.sim import CostEstimate, make_runner, Runner, STEP_BUDGET
 
 log = logging.getLogger(__name__)
@@ -107,51 +107,68 @@ def run_to_bag(scenario: Scenario, out: Path, storage: str = 'mcap',
     estimate = estimate or sim.plan(len(topics))
     peaks = PeakTracker(topics)
     make_parents(out)
-    status, message, frames, last_time = 'ok', '', 0, 0.0
+    done = _Progress()
     start = time.perf_counter()
     try:
         with BagRecorder(out, topics, storage) as bag:
             for frame in sim.frames():
                 bag.write(frame)
                 peaks.update(frame)
-                frames += 1
-                last_time = frame.time
+                done.frames += 1
+                done.last_time = frame.time
                 if progress is not None:
                     progress(1)
                 if should_stop is not None and should_stop():
-                    status, message = 'interrupted', 'stopped by a signal'
+                    done.status, done.message = 'interrupted', 'stopped by a signal'
                     break
     except SimulationError as exc:  # divergence, interface iterations that fail
-        status, message = 'diverged', str(exc)
+        done.status, done.message = 'diverged', str(exc)
     except KeyboardInterrupt:
-        status, message = 'interrupted', 'interrupted by a signal'
+        done.status, done.message = 'interrupted', 'interrupted by a signal'
         raise
     finally:
-        stepping = time.perf_counter() - start
-        wall = setup_time + stepping
-        summary = {
-            'ttb_sim_version': __version__,
-            'status': status,
-            'message': message,
-            'scenario': scenario.echo(),
-            'bag': {'path': str(out), 'storage': storage,
-                    'topics': [t.full_name() for t in topics]},
-            'solver': {'dt': sim.dt, 'steps_planned': sim.n_steps,
-                       'duration_planned': sim.duration, 'free_dofs': sim.n_free,
-                       'output_every_steps': sim.output_every, **sim.describe()},
-            'frames': frames,
-            'simulated_time': last_time,
-            'estimate': estimate.as_dict(),
-            'setup_time': setup_time,
-            'stepping_time': stepping,
-            'wall_time': wall,
-            'real_time_factor': last_time / wall if wall > 0 else None,
-            'peaks': peaks.summary(),
-        }
+        summary = _summary(scenario, sim, out, storage, topics, estimate, peaks, done,
+                           setup_time, time.perf_counter() - start)
         if out.is_dir():
             (out / 'summary.json').write_text(json.dumps(summary, indent=2) + '\n',
                                               encoding='utf-8')
-    return RunResult(path=out, status=status, summary=summary)
+    return RunResult(path=out, status=done.status, summary=summary)
+
+
+@dataclass
+class _Progress:
+    """How far a run got: its status and message, the frames written, the last frame's time."""
+
+    status: str = 'ok'
+    message: str = ''
+    frames: int = 0
+    last_time: float = 0.0
+
+
+def _summary(scenario: Scenario, sim: Runner, out: Path, storage: str, topics: Sequence[Topic],
+             estimate: CostEstimate, peaks: PeakTracker, done: _Progress, setup_time: float,
+             stepping: float) -> dict[str, Any]:
+    """Return the contents of ``summary.json``."""
+    wall = setup_time + stepping
+    return {
+        'ttb_sim_version': __version__,
+        'status': done.status,
+        'message': done.message,
+        'scenario': scenario.echo(),
+        'bag': {'path': str(out), 'storage': storage,
+                'topics': [t.full_name() for t in topics]},
+        'solver': {'dt': sim.dt, 'steps_planned': sim.n_steps,
+                   'duration_planned': sim.duration, 'free_dofs': sim.n_free,
+                   'output_every_steps': sim.output_every, **sim.describe()},
+        'frames': done.frames,
+        'simulated_time': done.last_time,
+        'estimate': estimate.as_dict(),
+        'setup_time': setup_time,
+        'stepping_time': stepping,
+        'wall_time': wall,
+        'real_time_factor': done.last_time / wall if wall > 0 else None,
+        'peaks': peaks.summary(),
+    }
 
 
 def run(scenario: str | Path, *, out: Path | None = None, storage: str = 'mcap',
