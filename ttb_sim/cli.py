@@ -28,12 +28,12 @@ import argparse
 import logging
 import os
 from pathlib import Path
-import signal
 import sys
 import threading
-from typing import Sequence
+from typing import Any, Sequence
 
 from ttb_sim import __version__
+from ttb_sim.commands.signals import SignalHandlers, stop_now
 from ttb_sim.errors import ModelError, ScenarioError, TtbSimError
 
 log = logging.getLogger('ttb_sim')
@@ -48,7 +48,13 @@ def _parser() -> argparse.ArgumentParser:
     p.add_argument('--version', action='version', version=f'%(prog)s {__version__}')
     p.add_argument('-v', '--verbose', action='store_true', help='log progress details')
     sub = p.add_subparsers(dest='command', required=True, metavar='COMMAND')
+    _add_model_verbs(sub)
+    _add_bag_verbs(sub)
+    return p
 
+
+def _add_model_verbs(sub: Any) -> None:
+    """Add the verbs that build a scenario's model: run, validate, bench, modes."""
     run = sub.add_parser('run', help='simulate a scenario and record a rosbag2')
     run.add_argument('scenario', help='YAML path or built-in name (see `ttb-sim scenarios`)')
     run.add_argument('--out', type=Path, help='bag directory to create (default: a new '
@@ -94,6 +100,9 @@ def _parser() -> argparse.ArgumentParser:
                     metavar='KEY=VALUE', help='override a scenario key; repeatable')
     mo.add_argument('--json', type=Path, metavar='FILE', help='also write the modes as JSON')
 
+
+def _add_bag_verbs(sub: Any) -> None:
+    """Add analyze and compare (they read bags), sweep (many runs, analysed) and scenarios."""
     an = sub.add_parser('analyze', help='figures, metrics.json and index.html from a bag')
     an.add_argument('bag', help='bag directory (metadata.yaml + .mcap/.db3) or storage file')
     an.add_argument('--out', type=Path, help='output folder (default: BAG/analysis)')
@@ -129,26 +138,14 @@ def _parser() -> argparse.ArgumentParser:
     sc = sub.add_parser('scenarios', help='list the built-in scenarios')
     sc.add_argument('--keys', action='store_true',
                     help='list every scenario key with unit, default and range')
-    return p
-
-
-def _stop_now(signum: int, frame: object) -> None:
-    """Before a verb takes over the signals nothing is written: end at once, one line."""
-    name = 'SIGTERM' if signum == signal.SIGTERM else 'SIGINT'
-    os.write(2, f'ttb-sim: stopped by {name}\n'.encode())
-    os._exit(128 + signum)
 
 
 def main(argv: Sequence[str] | None = None) -> int:
     """Run the command line; return the exit code."""
-    previous = {}
-    if threading.current_thread() is threading.main_thread():
-        previous = {sig: signal.signal(sig, _stop_now) for sig in (signal.SIGINT, signal.SIGTERM)}
-    try:
+    with SignalHandlers() as handlers:
+        if threading.current_thread() is threading.main_thread():
+            handlers.install(stop_now)
         return _main(argv)
-    finally:
-        for sig, handler in previous.items():
-            signal.signal(sig, handler)
 
 
 def entry() -> None:
@@ -162,8 +159,7 @@ def entry() -> None:
     ``os._exit`` once the verb has returned and the output is flushed.
     """
     if threading.current_thread() is threading.main_thread():
-        for sig in (signal.SIGINT, signal.SIGTERM):
-            signal.signal(sig, _stop_now)
+        SignalHandlers().install(stop_now)   # never restored: see above
     try:
         code = _main(sys.argv[1:])
     except SystemExit as exc:  # argparse's own exits (usage errors, --help)

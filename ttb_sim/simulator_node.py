@@ -18,24 +18,11 @@ The ROS 2 simulator node ``ttb_sim`` (``ros2 run ttb_sim simulator``).
 A thin rclpy shell over the ROS-free :mod:`ttb_sim.node`: it declares the parameters
 of :func:`~ttb_sim.node.parameters.parameter_table`, forwards parameter changes and
 service calls to a :class:`~ttb_sim.node.stepper.Stepper`, and copies frames,
-diagnostics and markers into standard messages.
-
-Threads:
-
-- the executor (a :class:`rclpy.executors.MultiThreadedExecutor`) answers
-  parameters and services and runs the 1 Hz diagnostics and the 10 Hz paused-clock
-  timers; it is never blocked by the model;
-- the stepping thread (:class:`~ttb_sim.node.stepper.Stepper`) builds the model
-  (``/diagnostics`` says "building model" meanwhile), opens the bag, steps paced by
-  ``real_time_factor``, writes every frame to the bag and closes it: the bag lives
-  on this one thread (SQLite requires it). It also publishes, through a
-  :class:`~ttb_sim.node.publishing.PublishLoop` without a thread of its own: after
-  each stepping tick, the frames due at ``publish_rate_hz`` go out as one batch
-  (messages built once per topic and updated in place,
-  :mod:`ttb_sim.node.message_cache`), within 20 % of the processor (CPU time),
-  dropping (and counting) frames beyond that budget instead of slowing the
-  stepping. A separate publishing thread was measured to cost more than the
-  publishing itself (the two threads fought over the interpreter lock).
+diagnostics and markers into standard messages (what it decides without ROS is in
+:mod:`ttb_sim.node.shell`). Its threads: the executor (a
+:class:`rclpy.executors.MultiThreadedExecutor`), which answers parameters and
+services and runs the 1 Hz diagnostics and the 10 Hz paused-clock timers, and the
+stepping thread, which builds, steps, records and publishes (:mod:`ttb_sim.node`).
 
 Publishers and their QoS (all explicit):
 
@@ -58,15 +45,12 @@ parameter values and types, bag destination) are one FATAL line and exit code 2.
 from __future__ import annotations
 
 import functools
-import logging
 from pathlib import Path
 import sys
-import threading
-from typing import Any, Sequence
+from typing import Any, Callable, Sequence
 
 from builtin_interfaces.msg import Time
-from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
-from geometry_msgs.msg import Point, Pose, Quaternion, Vector3
+from diagnostic_msgs.msg import DiagnosticArray
 from rcl_interfaces.msg import (FloatingPointRange, IntegerRange, ParameterDescriptor,
                                 ParameterType, SetParametersResult)
 import rclpy
@@ -81,21 +65,22 @@ from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPo
 from rclpy.task import Future
 from rosgraph_msgs.msg import Clock as ClockMsg
 from rosidl_runtime_py.utilities import get_message
-from std_msgs.msg import ColorRGBA, Header
 from std_srvs.srv import SetBool, Trigger
-from ttb_sim.config import load_scenario
 from ttb_sim.errors import ModelError, ScenarioError
-from ttb_sim.io.bag import BagRecorder, check_destination, default_bag_path, make_parents
-from ttb_sim.io.topics import FRAME_ID, Topic, topic_table
-from ttb_sim.node import (DEFAULT_SCENARIO, initial_values, markers, MarkerSet, NodeParameter,
-                          parameter_table, PassageController, validate_changes,
+from ttb_sim.io.topics import Topic, topic_table
+from ttb_sim.node import (markers, NodeParameter, PassageController, validate_changes,
                           validate_parameter)
+from ttb_sim.node.diagnostics import diagnostic_array
+from ttb_sim.node.markers import marker_array
 from ttb_sim.node.message_cache import MessageCache
 from ttb_sim.node.passage import FrameSink, Tick
 from ttb_sim.node.publishing import PublishLoop
+from ttb_sim.node.shell import (bag_destination, building_message, ClockGuard,
+                                declare_parameters, live_topics, node_diagnostics, open_bag,
+                                pause_answer, quiet_repeated_warnings, tick_messages)
 from ttb_sim.node.stepper import Stepper
-from ttb_sim.sim.frames import Frame, Layout
-from visualization_msgs.msg import Marker, MarkerArray
+from ttb_sim.sim import Frame, Layout
+from visualization_msgs.msg import MarkerArray
 
 STEP_BUDGET = 0.02
 """Wall-clock seconds one stepping tick may spend before it hands its frames on."""
@@ -122,26 +107,6 @@ _PARAM_TYPES = {'bool': ParameterType.PARAMETER_BOOL,
                 'integer': ParameterType.PARAMETER_INTEGER,
                 'double': ParameterType.PARAMETER_DOUBLE,
                 'string': ParameterType.PARAMETER_STRING}
-
-
-class OnceFilter(logging.Filter):
-    """Let each distinct log message through once (a model warning, not once per passage)."""
-
-    def __init__(self) -> None:
-        super().__init__()
-        self._seen: set[str] = set()
-
-    def filter(self, record: logging.LogRecord) -> bool:  # noqa: A003 - logging API
-        """Return True the first time a message is seen."""
-        message = record.getMessage()
-        if message in self._seen:
-            return False
-        self._seen.add(message)
-        return True
-
-
-ONCE_LOGGERS = ('ttb_sim.sim.simulation',)
-"""Loggers of the model whose warnings repeat with every passage (each builds the model)."""
 
 
 @functools.lru_cache(maxsize=None)
@@ -215,8 +180,7 @@ class SimulatorNode(Node):
         self._messages: MessageCache | None = None
         self.fatal = Future()
         self._fatal: tuple[str, int] = ('', 0)
-        self._clock_lock = threading.Lock()
-        self._last_clock = -1
+        self._clock_guard = ClockGuard()
         self._last_build_log = 0.0
         self._closed = False
         try:
@@ -247,34 +211,20 @@ class SimulatorNode(Node):
                                 f'{param.allowed()})') from None
 
     def _configure(self) -> None:
-        for name in ONCE_LOGGERS:
-            logger = logging.getLogger(name)
-            if not any(isinstance(f, OnceFilter) for f in logger.filters):
-                logger.addFilter(OnceFilter())
-        first = parameter_table()['scenario']
-        source = self._declare('scenario', DEFAULT_SCENARIO, first)
-        scenario = load_scenario(source)
-        self.scenario = scenario
-        self.table = parameter_table(scenario)
-        given: dict[str, Any] = {'scenario': source}
-        for name, param in self.table.items():
-            if name != 'scenario':
-                given[name] = self._declare(name, param.default, param)
-        values = initial_values(self.table, given)
-        self.values = values
+        quiet_repeated_warnings()
+        start = declare_parameters(self._declare)
+        scenario, self.table, values = start.scenario, start.table, start.values
+        self.scenario, self.values = scenario, values
         # Start-up integers for double parameters: store them as doubles, too.
-        retype = [Parameter(n, Parameter.Type.DOUBLE, values[n]) for n, p in self.table.items()
-                  if p.kind == 'double' and not isinstance(given[n], float)]
+        retype = [Parameter(n, Parameter.Type.DOUBLE, values[n])
+                  for n in start.integers_for_doubles()]
         if retype:
             self.set_parameters(retype)
 
         self.namespace = self.get_fully_qualified_name()
-        open_recorder = None
-        if values['bag.enabled']:
-            path = Path(values['bag.path']) if values['bag.path'] else \
-                default_bag_path(scenario.name)
-            check_destination(path, values['bag.storage'], option='bag.path')
-            open_recorder = functools.partial(self._open_recorder, path, values['bag.storage'])
+        path = bag_destination(values, scenario.name)
+        open_recorder = None if path is None else \
+            functools.partial(self._open_recorder, path, values['bag.storage'])
 
         self.clock_pub = self.create_publisher(ClockMsg, '/clock', QOS['clock'])
         self.diagnostics_pub = self.create_publisher(DiagnosticArray, '/diagnostics',
@@ -305,9 +255,7 @@ class SimulatorNode(Node):
 
     def _open_recorder(self, path: Path, storage: str, layout: Layout) -> FrameSink:
         """Open the bag (on the stepping thread, which also writes and closes it)."""
-        make_parents(path)
-        recorder = BagRecorder(path, topic_table(layout), storage,
-                               namespace=self.namespace).__enter__()
+        recorder = open_bag(path, storage, layout, self.namespace)
         self._log('info', f'recording to {path} ({storage})')
         return recorder
 
@@ -331,15 +279,12 @@ class SimulatorNode(Node):
         if controller is None or self.publish_loop is not None or self._closed:
             return
         self.topics = topic_table(controller.layout)
-        for topic in self.topics:
-            if topic.qos == 'clock':
-                continue
-            name = topic.name if topic.name.startswith('/') else f'~/{topic.name}'
+        live = live_topics(self.topics)
+        for topic, name in live:
             self.publishers_by_name[topic.name] = self.create_publisher(
                 message_class(topic.msgtype), name, QOS[topic.qos])
-        live = [t for t in self.topics if t.qos != 'clock']
-        self._live = [self.publishers_by_name[t.name] for t in live]
-        self._messages = MessageCache(live, message_class)
+        self._live = [self.publishers_by_name[t.name] for t, _ in live]
+        self._messages = MessageCache([t for t, _ in live], message_class)
         self.publish_loop = PublishLoop(self._publish_frames, duty=PUBLISH_DUTY,
                                         threaded=False)
         self.publish_loop.start()
@@ -381,47 +326,35 @@ class SimulatorNode(Node):
 
     def _building(self) -> str:
         assert self.stepper is not None
-        status = self.stepper.status()
-        if status.state == 'failed':
-            return f'the model could not be built: {status.error}'
-        return f'the model is still being built ({status.elapsed:.1f} s so far); try again'
+        return building_message(self.stepper.status())
+
+    def _serve(self, act: Callable[[PassageController], tuple[bool, str]]) -> tuple[bool, str]:
+        """Answer a service: (False, why) before the model exists, else act and wake stepping."""
+        controller = self.controller
+        if controller is None:
+            return False, self._building()
+        answer = act(controller)
+        if self.stepper is not None:
+            self.stepper.wake()
+        return answer
 
     def _on_reset(self, request: Trigger.Request,
                   response: Trigger.Response) -> Trigger.Response:
-        controller = self.controller
-        if controller is None:
-            response.success, response.message = False, self._building()
-            return response
-        response.message = controller.reset()
-        response.success = True
-        self._wake_stepper()
+        response.success, response.message = self._serve(lambda c: (True, c.reset()))
         return response
 
     def _on_pause(self, request: SetBool.Request,
                   response: SetBool.Response) -> SetBool.Response:
-        controller = self.controller
-        if controller is None:
-            response.success, response.message = False, self._building()
-            return response
-        response.message = controller.set_paused(bool(request.data))
-        response.success = controller.state in ('paused', 'running')
-        self._wake_stepper()
+        response.success, response.message = self._serve(
+            lambda c: pause_answer(c, bool(request.data)))
         return response
-
-    def _wake_stepper(self) -> None:
-        if self.stepper is not None:
-            self.stepper.wake()
 
     # -- stepping and publishing --------------------------------------------------------
 
     def _on_tick(self, tick: Tick) -> None:
         """Log passage events and hand the frames to the publisher (stepping thread)."""
-        if 'diverged' in tick.events and self.controller is not None:
-            self._log('error', f'{self.controller.divergence}; stepping stopped, bag closed; '
-                      'call ~/reset to restart')
-        if 'idle' in tick.events:
-            self._log('info', 'the train has left: idle (set loop:=true or call ~/reset for '
-                      'another passage)')
+        for level, message in tick_messages(tick, self.controller):
+            self._log(level, message)
         if self.publish_loop is not None:
             self.publish_loop.offer(tick.frames, tick.markers)
 
@@ -448,12 +381,8 @@ class SimulatorNode(Node):
 
     def _publish_clock(self, stamp_ns: int) -> None:
         """Publish /clock unless that would go back in time (from any thread)."""
-        with self._clock_lock:
-            if stamp_ns < self._last_clock:
-                return
-            self._last_clock = stamp_ns
-            sec, nanosec = divmod(int(stamp_ns), 1_000_000_000)
-            self.clock_pub.publish(ClockMsg(clock=Time(sec=sec, nanosec=nanosec)))
+        self._clock_guard.send(stamp_ns, lambda sec, nanosec: self.clock_pub.publish(
+            ClockMsg(clock=Time(sec=sec, nanosec=nanosec))))
 
     def _on_paused_clock(self) -> None:
         """While paused, idle or diverged, keep /clock at the current simulation time."""
@@ -464,44 +393,27 @@ class SimulatorNode(Node):
         self._publish_clock(round(controller.node_time * 1e9))
 
     def _publish_markers(self, head_position: float) -> None:
-        self.markers_pub.publish(marker_array(markers(self.scenario, head_position)))
+        self.markers_pub.publish(marker_array(message_class,
+                                              markers(self.scenario, head_position)))
 
     def _on_diagnostics(self) -> None:
         if self.stepper is None:
             return
         controller = self.controller
         status = self.stepper.status()
-        if controller is None:
-            if status.state == 'failed':
-                level, message = 2, f'cannot build the model: {status.error}'
-            else:
-                level, message = 0, f'building model: {status.elapsed:.1f} s'
-                if status.elapsed - self._last_build_log >= 2.0:
-                    self._last_build_log = status.elapsed
-                    self.get_logger().info(f'building model {self.scenario.name!r}: '
-                                           f'{status.elapsed:.1f} s so far')
-            values = [('state', status.state), ('scenario', self.scenario.name),
-                      ('build time so far (s)', f'{status.elapsed:.1f}')]
-        else:
-            report = controller.diagnostics()
-            level, message = report.level, report.message
-            values = list(report.values)
-            values.append(('model build time (s)', f'{status.elapsed:.2f}'))
-            if status.state == 'failed':
-                level, message = 2, status.error
-            if self.publish_loop is not None:
-                stats = self.publish_loop.stats()
-                values += [('published frames', str(stats.published)),
-                           ('dropped frames (publishing could not keep up)',
-                            str(stats.dropped)),
-                           ('publish CPU time per frame (ms)', f'{stats.ms_per_frame:.3f}')]
-                if self.publish_loop.error:
-                    level, message = 2, self.publish_loop.error
-        diag = DiagnosticStatus(level=bytes([level]), name='ttb_sim: simulation',
-                                message=message, hardware_id=self.get_name(),
-                                values=[KeyValue(key=k, value=v) for k, v in values])
-        header = Header(stamp=self.get_clock().now().to_msg(), frame_id='')
-        self.diagnostics_pub.publish(DiagnosticArray(header=header, status=[diag]))
+        if (controller is None and status.state != 'failed'
+                and status.elapsed - self._last_build_log >= 2.0):
+            self._last_build_log = status.elapsed
+            self.get_logger().info(f'building model {self.scenario.name!r}: '
+                                   f'{status.elapsed:.1f} s so far')
+        loop = self.publish_loop if controller is not None else None
+        report = node_diagnostics(self.scenario.name, status,
+                                  controller.diagnostics() if controller is not None else None,
+                                  loop.stats() if loop is not None else None,
+                                  loop.error if loop is not None else '')
+        self.diagnostics_pub.publish(diagnostic_array(
+            message_class, report, 'ttb_sim: simulation', self.get_name(),
+            self.get_clock().now().to_msg()))
 
     def close(self) -> None:
         """Stop publishing, then stepping; the bag is closed on the stepping thread."""
@@ -512,36 +424,6 @@ class SimulatorNode(Node):
         if self.stepper is not None and not self.stepper.stop(timeout=1.0 if building else 10.0):
             self._log('warning', 'the model is still being built; leaving it behind (no bag '
                       'was open yet)')
-
-
-def marker_array(marker_set: MarkerSet) -> MarkerArray:
-    """
-    Copy a plain marker description into a ``visualization_msgs/msg/MarkerArray``.
-
-    Parameters
-    ----------
-    marker_set : MarkerSet
-        Boxes in the track frame.
-
-    Returns
-    -------
-    MarkerArray
-        One CUBE marker per box, stamp zero (latest transform), never expiring.
-
-    """
-    header = Header(stamp=Time(sec=0, nanosec=0), frame_id=marker_set.frame_id or FRAME_ID)
-    out = []
-    for box in marker_set.boxes:
-        x, y, z = (float(v) for v in box.position)
-        sx, sy, sz = (float(v) for v in box.size)
-        r, g, b, a = (float(v) for v in box.color)
-        out.append(Marker(header=header, ns=box.ns, id=box.marker_id, type=Marker.CUBE,
-                          action=Marker.ADD,
-                          pose=Pose(position=Point(x=x, y=y, z=z),
-                                    orientation=Quaternion(x=0.0, y=0.0, z=0.0, w=1.0)),
-                          scale=Vector3(x=sx, y=sy, z=sz),
-                          color=ColorRGBA(r=r, g=g, b=b, a=a), frame_locked=False))
-    return MarkerArray(markers=out)
 
 
 def _shutting_down(context: Any = None) -> bool:

@@ -31,7 +31,7 @@ import numpy as np
 
 from ttb_sim.io.bag import BagRecorder
 from ttb_sim.io.topics import topic_table
-from ttb_sim.sim.frames import Frame, Layout
+from ttb_sim.sim import Frame, Layout
 
 RATE = 500.0
 SAMPLES = 1000          # 2 s: 0.5 Hz bins, every tone a whole number of periods

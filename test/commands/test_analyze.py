@@ -34,11 +34,10 @@ import numpy as np
 import pytest
 
 from ttb_sim.cli import main
-from ttb_sim.commands.compare import flatten
-from ttb_sim.commands.report import bag_metrics
-from ttb_sim.commands.streams import load_streams
+from ttb_sim.io.streams import load_streams
 from ttb_sim.io.topics import topic_table
-from ttb_sim.sim.frames import Layout
+from ttb_sim.report.metrics import bag_metrics, flatten
+from ttb_sim.sim import Layout
 
 import synthetic_bag as sb   # noqa: I100 - the helper next to this file
 

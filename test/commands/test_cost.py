@@ -28,8 +28,7 @@ from ttb_sim.cli import main
 from ttb_sim.commands.validate import validate
 from ttb_sim.config import load_scenario
 from ttb_sim.errors import ScenarioError
-from ttb_sim.sim.cost import estimate_cost, STEP_BUDGET
-from ttb_sim.sim.simulation import Simulation
+from ttb_sim.sim import estimate_cost, Simulation, STEP_BUDGET
 
 
 def test_the_plan_is_told_and_written(tmp_path: Path, capsys) -> None:

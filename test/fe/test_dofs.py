@@ -19,7 +19,7 @@ import pytest
 from ttb_sim.config import load_scenario
 from ttb_sim.errors import ModelError
 from ttb_sim.fe.dofs import DofMap
-from ttb_sim.sim.build import build_structure
+from ttb_sim.sim import build_structure
 
 
 def test_free_numbering_skips_constrained_dofs_and_keeps_an_extended_zero_slot():

@@ -26,10 +26,11 @@ import array
 import numpy as np
 import pytest
 from rosbags.rosbag2 import Reader
-from ttb_sim.io.bag import BagRecorder, typestore
+from ttb_sim.io.bag import BagRecorder
+from ttb_sim.io.cdr import typestore
 from ttb_sim.io.reader import read_bag
 from ttb_sim.io.topics import build_point_cloud, SOIL_FIELDS, topic_table
-from ttb_sim.sim.frames import Frame, Layout
+from ttb_sim.sim import Frame, Layout
 
 LAYOUT = Layout(n_spans=1, n_supports=2, n_bodies=0, piles=((7, 3), (8, 2)), soil_points=4)
 

@@ -33,12 +33,13 @@ import pytest
 from rosbags.rosbag2 import StoragePlugin, Writer
 from ttb_sim.config import load_scenario
 from ttb_sim.errors import BagError, ScenarioError
+from ttb_sim.io import cdr as cdr_module
 from ttb_sim.io import reader as reader_module
-from ttb_sim.io.bag import BagRecorder, typestore
+from ttb_sim.io.bag import BagRecorder
+from ttb_sim.io.cdr import typestore
 from ttb_sim.io.reader import bag_topics, read_bag, SUPPORTED_TYPES, TopicArrays
 from ttb_sim.io.topics import topic_table
-from ttb_sim.sim.frames import Frame
-from ttb_sim.sim.simulation import Simulation
+from ttb_sim.sim import Frame, Simulation
 
 NS = '/ttb_sim'
 
@@ -159,8 +160,8 @@ def test_the_per_message_path_gives_the_same_arrays(written, monkeypatch):
     fast = read_bag(paths['mcap'])
 
     def no_layout(*args, **kwargs):
-        raise reader_module._NoLayout
-    monkeypatch.setattr(reader_module, '_Layout', no_layout)
+        raise cdr_module.NoLayout
+    monkeypatch.setattr(cdr_module, 'CdrLayout', no_layout)
     slow = read_bag(paths['mcap'])
     for topic in fast:
         np.testing.assert_array_equal(fast[topic].stamp_ns, slow[topic].stamp_ns)
@@ -356,12 +357,12 @@ def test_an_empty_topic_has_empty_arrays():
 def test_one_layout_per_topic_and_cdr_shape(written, recorded, monkeypatch):
     """Messages of one shape are decoded together: one layout each, not one per message."""
     built: list[str] = []
-    original = reader_module._Layout
+    original = cdr_module.CdrLayout
 
     def spy(store, msgtype, data):
         built.append(msgtype)
         return original(store, msgtype, data)
-    monkeypatch.setattr(reader_module, '_Layout', spy)
+    monkeypatch.setattr(cdr_module, 'CdrLayout', spy)
     paths, frames = written
     assert len(read_bag(paths['mcap'])) == len(built) == 11
     built.clear()

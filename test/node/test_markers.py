@@ -14,9 +14,11 @@
 
 """Tests of the structure and train markers (plain boxes for ~/model/markers)."""
 
+from types import SimpleNamespace
+
 import pytest
 from ttb_sim.config import load_scenario
-from ttb_sim.node.markers import markers, model_markers, train_markers
+from ttb_sim.node.markers import marker_array, markers, model_markers, train_markers
 
 
 def test_markers_describe_girders_supports_and_train():
@@ -71,3 +73,26 @@ def test_piled_piers_stand_on_their_pile_groups():
         assert len(group) == 15
         assert max(b.position[2] + b.size[2] / 2 for b in group) == pytest.approx(-height - cap)
     assert [b.ns for b in boxes].count('piers') == 9
+
+
+def _message_types(name):
+    """Message classes with default fields, as rclpy's (plain namespaces here)."""
+    cls = type(name.rsplit('/', 1)[1], (SimpleNamespace,), {'CUBE': 1, 'ADD': 0})
+    cls.type_name = name
+    return cls
+
+
+def test_marker_array_has_one_cube_per_box():
+    scenario = load_scenario('moving_force_beam', ['bridge.n_spans=3'])
+    full = markers(scenario, 100.0)
+    array = marker_array(_message_types, full)
+    assert array.type_name == 'visualization_msgs/msg/MarkerArray'
+    assert len(array.markers) == len(full.boxes)
+    for box, marker in zip(full.boxes, array.markers):
+        assert (marker.ns, marker.id, marker.type, marker.action) == (box.ns, box.marker_id, 1, 0)
+        assert marker.header.frame_id == 'track' and marker.header.stamp.sec == 0
+        position, scale, color = marker.pose.position, marker.scale, marker.color
+        assert (position.x, position.y, position.z) == box.position
+        assert (scale.x, scale.y, scale.z) == box.size
+        assert (color.r, color.g, color.b, color.a) == box.color
+        assert marker.pose.orientation.w == 1.0 and marker.frame_locked is False

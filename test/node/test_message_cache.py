@@ -25,10 +25,10 @@ from __future__ import annotations
 import itertools
 
 from ttb_sim.config import load_scenario
-from ttb_sim.io.bag import typestore
+from ttb_sim.io.cdr import typestore
 from ttb_sim.io.topics import topic_table
 from ttb_sim.node.message_cache import MessageCache
-from ttb_sim.sim.runner import make_runner
+from ttb_sim.sim import make_runner
 
 
 def test_cached_messages_serialise_like_fresh_ones():

@@ -23,9 +23,10 @@ from rosbags.highlevel import AnyReader
 from ttb_sim.config import load_scenario, Scenario
 from ttb_sim.io.bag import BagRecorder
 from ttb_sim.io.topics import topic_table
+from ttb_sim.node.diagnostics import ERROR, OK
 from ttb_sim.node.parameters import initial_values, parameter_table
-from ttb_sim.node.passage import ERROR, OK, PassageController
-from ttb_sim.sim.frames import Frame
+from ttb_sim.node.passage import PassageController
+from ttb_sim.sim import Frame
 
 
 class FakeClock:

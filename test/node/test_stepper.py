@@ -36,7 +36,7 @@ from ttb_sim.errors import ScenarioError
 from ttb_sim.io.bag import BagRecorder
 from ttb_sim.io.topics import topic_table
 from ttb_sim.node import DEFAULT_SCENARIO, initial_values, parameter_table, Stepper, Tick
-from ttb_sim.sim.frames import Frame, Layout
+from ttb_sim.sim import Frame, Layout
 from polling import poll_until  # noqa: I100 - the helper in test/
 
 TIMEOUT = 60.0

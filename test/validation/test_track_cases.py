@@ -25,7 +25,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from ttb_sim.sim.simulation import Simulation
+from ttb_sim.sim import Simulation
 from ttb_sim.validation.cases import track as tc
 from ttb_sim.validation.cases.registry import CASES
 from ttb_sim.validation.references import track as tr

@@ -31,6 +31,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ttb_sim.analysis.weighting import Weighting, weighting_db
+from ttb_sim.errors import ScenarioError
 
 __all__ = ['A0', 'band_rms', 'band_sums', 'line_power', 'third_octave_bands', 'total_level',
            'vibration_levels']
@@ -48,7 +49,7 @@ def third_octave_bands(lowest: float = 1.0, highest: float = 80.0
     [lowest, highest] (a 2 % tolerance admits the nominal 80 Hz = 10^1.9).
     """
     if not (0 < lowest <= highest):
-        raise ValueError(f'need 0 < lowest <= highest, got {lowest!r}, {highest!r}')
+        raise ScenarioError(f'need 0 < lowest <= highest, got {lowest!r}, {highest!r}')
     n = np.arange(math.floor(10 * math.log10(lowest * 0.98)),
                   math.ceil(10 * math.log10(highest * 1.02)) + 1)
     centres = 10.0 ** (n / 10.0)
@@ -61,11 +62,11 @@ def line_power(signal: ArrayLike, sample_rate: float
     """Return (f, mean square per FFT line) of a record, mean removed (sum: the variance)."""
     x = np.asarray(signal, dtype=float)
     if x.ndim != 1 or x.size < 2:
-        raise ValueError(f'signal must be a 1-D array of at least 2 samples, got {x.shape}')
+        raise ScenarioError(f'signal must be a 1-D array of at least 2 samples, got {x.shape}')
     if not np.all(np.isfinite(x)):
-        raise ValueError('signal must be finite')
+        raise ScenarioError('signal must be finite')
     if not (math.isfinite(sample_rate) and sample_rate > 0):
-        raise ValueError(f'sample_rate must be > 0, got {sample_rate!r}')
+        raise ScenarioError(f'sample_rate must be > 0, got {sample_rate!r}')
     power = np.abs(np.fft.rfft(x - x.mean()))**2 / x.size**2
     power[1:(x.size + 1) // 2] *= 2.0
     return np.asarray(np.fft.rfftfreq(x.size, 1.0 / sample_rate), dtype=float), power

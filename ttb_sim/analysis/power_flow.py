@@ -31,6 +31,8 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from ttb_sim.errors import ScenarioError
+
 __all__ = ['band_power', 'power_flow_spectrum', 'velocity_from_displacement']
 
 
@@ -39,10 +41,10 @@ def _pair(force: ArrayLike,
     f = np.asarray(force, dtype=float)
     v = np.asarray(velocity, dtype=float)
     if f.ndim != 1 or f.shape != v.shape or f.size < 2:
-        raise ValueError(f'force and velocity must be 1-D arrays of the same length >= 2, '
-                         f'got shapes {f.shape} and {v.shape}')
+        raise ScenarioError(f'force and velocity must be 1-D arrays of the same length >= 2, '
+                            f'got shapes {f.shape} and {v.shape}')
     if not (np.all(np.isfinite(f)) and np.all(np.isfinite(v))):
-        raise ValueError('force and velocity must be finite')
+        raise ScenarioError('force and velocity must be finite')
     return f, v
 
 
@@ -69,7 +71,7 @@ def power_flow_spectrum(force: ArrayLike, velocity: ArrayLike, sample_rate: floa
     """
     f_rec, v_rec = _pair(force, velocity)
     if not (np.isfinite(sample_rate) and sample_rate > 0):
-        raise ValueError(f'sample_rate must be > 0, got {sample_rate!r}')
+        raise ScenarioError(f'sample_rate must be > 0, got {sample_rate!r}')
     n = f_rec.size
     cross = np.fft.rfft(f_rec) * np.conj(np.fft.rfft(v_rec))
     p = 2.0 * cross.real / n**2
@@ -100,6 +102,6 @@ def velocity_from_displacement(displacement: ArrayLike, sample_rate: float
     """
     u = np.asarray(displacement, dtype=float)
     if u.ndim != 1 or u.size < 3:
-        raise ValueError(f'displacement must be a 1-D array of at least 3 samples, '
-                         f'got shape {u.shape}')
+        raise ScenarioError(f'displacement must be a 1-D array of at least 3 samples, '
+                            f'got shape {u.shape}')
     return np.asarray(np.gradient(u, 1.0 / sample_rate, edge_order=2), dtype=float)

@@ -49,6 +49,8 @@ from numpy.typing import ArrayLike, NDArray
 from scipy import fft as sfft
 from scipy import signal as ssig
 
+from ttb_sim.errors import ScenarioError
+
 __all__ = [
     'MIN_SEGMENT_SAMPLES',
     'MIN_WINDOW_BINS',
@@ -72,38 +74,38 @@ def _record(signal: ArrayLike) -> NDArray[np.float64]:
     """Return the signal as a finite 1-D float array of at least MIN_SEGMENT_SAMPLES samples."""
     x = np.asarray(signal, dtype=float)
     if x.ndim != 1:
-        raise ValueError(f'signal must be a 1-D array, got shape {x.shape}')
+        raise ScenarioError(f'signal must be a 1-D array, got shape {x.shape}')
     if x.size < MIN_SEGMENT_SAMPLES:
-        raise ValueError(
+        raise ScenarioError(
             f'signal must have at least {MIN_SEGMENT_SAMPLES} samples, got {x.size}')
     bad = np.flatnonzero(~np.isfinite(x))
     if bad.size:
-        raise ValueError(
+        raise ScenarioError(
             f'signal must be finite, got {x[bad[0]]} at sample {bad[0]} '
             f'({bad.size} non-finite samples)')
     return x
 
 
 def _positive(name: str, value: float) -> float:
-    """Return value as a float, or raise ValueError unless it is finite and > 0."""
+    """Return value as a float, or raise ScenarioError unless it is finite and > 0."""
     try:
         number = float(value)
     except (TypeError, ValueError):
-        raise ValueError(f'{name} must be a finite number > 0, got {value!r}') from None
+        raise ScenarioError(f'{name} must be a finite number > 0, got {value!r}') from None
     if not (np.isfinite(number) and number > 0.0):
-        raise ValueError(f'{name} must be a finite number > 0, got {value!r}')
+        raise ScenarioError(f'{name} must be a finite number > 0, got {value!r}')
     return number
 
 
 def _detrend(detrend: str | bool) -> str | bool:
-    """Return the detrend option, or raise ValueError for an unknown one."""
+    """Return the detrend option, or raise ScenarioError for an unknown one."""
     if isinstance(detrend, bool):
         if detrend:
-            raise ValueError(
+            raise ScenarioError(
                 f"detrend must be one of 'constant', 'linear' or False, got {detrend!r}")
         return False
     if detrend not in _DETRENDS:
-        raise ValueError(
+        raise ScenarioError(
             f"detrend must be one of 'constant', 'linear' or False, got {detrend!r}")
     return detrend
 
@@ -140,7 +142,7 @@ def welch_psd(signal: ArrayLike, sample_rate: float, segment_seconds: float | No
 
     Raises
     ------
-    ValueError
+    ScenarioError
         For a record that is not 1-D, too short or not finite, a rate that is
         not > 0, a segment outside the allowed length or an unknown detrend.
 
@@ -154,7 +156,7 @@ def welch_psd(signal: ArrayLike, sample_rate: float, segment_seconds: float | No
         seconds = _positive('segment_seconds', segment_seconds)
         nperseg = int(round(seconds * fs))
         if not MIN_SEGMENT_SAMPLES <= nperseg <= x.size:
-            raise ValueError(
+            raise ScenarioError(
                 f'segment_seconds must give between {MIN_SEGMENT_SAMPLES} and {x.size} samples '
                 f'(the record, {x.size / fs:g} s at {fs:g} Hz), got {segment_seconds!r} s '
                 f'= {nperseg} samples')
@@ -198,7 +200,7 @@ def padded_periodogram(signal: ArrayLike, sample_rate: float, pad_factor: int = 
 
     Raises
     ------
-    ValueError
+    ScenarioError
         As :func:`welch_psd`, and for a pad factor that is not an integer >= 1.
 
     """
@@ -207,7 +209,7 @@ def padded_periodogram(signal: ArrayLike, sample_rate: float, pad_factor: int = 
     trend = _detrend(detrend)
     if isinstance(pad_factor, bool) or not isinstance(pad_factor, (int, np.integer)) \
             or pad_factor < 1:
-        raise ValueError(f'pad_factor must be an integer >= 1, got {pad_factor!r}')
+        raise ScenarioError(f'pad_factor must be an integer >= 1, got {pad_factor!r}')
     nfft = sfft.next_fast_len(int(pad_factor) * x.size, real=True)
     f, p = ssig.periodogram(x, fs=fs, window='hann', nfft=nfft, detrend=trend,
                             return_onesided=True, scaling='density')
@@ -221,17 +223,17 @@ def _spectrum(f: ArrayLike, p: ArrayLike) -> tuple[NDArray[np.float64], NDArray[
     freq = np.asarray(f, dtype=float)
     psd = np.asarray(p, dtype=float)
     if freq.ndim != 1 or psd.shape != freq.shape:
-        raise ValueError(
+        raise ScenarioError(
             f'f and p must be 1-D arrays of the same length, got shapes {freq.shape} '
             f'and {psd.shape}')
     if freq.size < 3:
-        raise ValueError(f'f and p must have at least 3 bins, got {freq.size}')
+        raise ScenarioError(f'f and p must have at least 3 bins, got {freq.size}')
     if not (np.all(np.isfinite(freq)) and np.all(np.isfinite(psd))):
-        raise ValueError('f and p must be finite, got NaN or infinite values')
+        raise ScenarioError('f and p must be finite, got NaN or infinite values')
     if np.any(np.diff(freq) <= 0.0):
-        raise ValueError('f must be strictly increasing')
+        raise ScenarioError('f must be strictly increasing')
     if np.any(psd < 0.0):
-        raise ValueError(f'p must be >= 0, got minimum {psd.min()!r}')
+        raise ScenarioError(f'p must be >= 0, got minimum {psd.min()!r}')
     return freq, psd
 
 
@@ -242,13 +244,13 @@ def _band(freq: NDArray[np.float64], band: tuple[float, float] | None) -> NDArra
     try:
         lo, hi = (float(b) for b in band)
     except (TypeError, ValueError):
-        raise ValueError(f'band must be a pair (lo, hi) of numbers in Hz, got {band!r}') \
+        raise ScenarioError(f'band must be a pair (lo, hi) of numbers in Hz, got {band!r}') \
             from None
     if not (np.isfinite(lo) and np.isfinite(hi) and lo < hi):
-        raise ValueError(f'band must satisfy lo < hi, both finite, got {band!r}')
+        raise ScenarioError(f'band must satisfy lo < hi, both finite, got {band!r}')
     index = np.flatnonzero((freq >= lo) & (freq <= hi))
     if index.size == 0:
-        raise ValueError(
+        raise ScenarioError(
             f'band {band!r} Hz holds no bin of f ({freq[0]:g} .. {freq[-1]:g} Hz)')
     return index
 
@@ -289,7 +291,7 @@ def peak_frequency(f: ArrayLike, p: ArrayLike, band: tuple[float, float] | None 
 
     Raises
     ------
-    ValueError
+    ScenarioError
         For mismatched, non-finite or negative input, a band holding no bin,
         or ``fit_bins`` not an odd integer >= 3.
 
@@ -297,7 +299,7 @@ def peak_frequency(f: ArrayLike, p: ArrayLike, band: tuple[float, float] | None 
     freq, psd = _spectrum(f, p)
     if isinstance(fit_bins, bool) or not isinstance(fit_bins, (int, np.integer)) \
             or fit_bins < 3 or fit_bins % 2 == 0:
-        raise ValueError(f'fit_bins must be an odd integer >= 3, got {fit_bins!r}')
+        raise ScenarioError(f'fit_bins must be an odd integer >= 3, got {fit_bins!r}')
     index = _band(freq, band)
     i = int(index[np.argmax(psd[index])])
     if i == 0 or i == freq.size - 1:
@@ -336,6 +338,54 @@ def _line_at(x: NDArray[np.float64], y: NDArray[np.float64], width: int,
     slope = np.divide(width * sxy - sx * sy, spread, out=np.zeros_like(spread),
                       where=spread > 0.0)
     return (sy - slope * sx) / width + slope * at
+
+
+def _positive_band(freq: NDArray[np.float64], psd: NDArray[np.float64],
+                   band: tuple[float, float] | None
+                   ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """Return f and p inside the band (without a zero-frequency bin), both > 0 there."""
+    index = _band(freq, band)
+    if band is None:
+        index = index[freq[index] > 0.0]
+    sel_f, sel_p = freq[index], psd[index]
+    if sel_f[0] <= 0.0 or np.any(sel_p <= 0.0):
+        raise ScenarioError(
+            f'f and p must be > 0 inside band {band!r}, got f from {sel_f[0]!r} Hz and '
+            f'minimum p {sel_p.min()!r}')
+    return sel_f, sel_p
+
+
+def _window_width(window_bins: int | None, count: int, band: tuple[float, float] | None) -> int:
+    """Return the bins fitted on each side of a break (checked against the band's bins)."""
+    if window_bins is None:
+        width = max(MIN_WINDOW_BINS, count // 8)
+    elif isinstance(window_bins, bool) or not isinstance(window_bins, (int, np.integer)) \
+            or window_bins < MIN_WINDOW_BINS:
+        raise ScenarioError(
+            f'window_bins must be an integer >= {MIN_WINDOW_BINS}, got {window_bins!r}')
+    else:
+        width = int(window_bins)
+    if count < 2 * width:
+        raise ScenarioError(
+            f'band {band!r} must hold at least 2 * window_bins = {2 * width} bins, '
+            f'got {count}')
+    return width
+
+
+def _level_steps(sel_f: NDArray[np.float64], sel_p: NDArray[np.float64], width: int
+                 ) -> tuple[NDArray[np.intp], NDArray[np.float64]]:
+    """Return the candidate breaks and the level step (decades) of the two fits at each."""
+    count = sel_f.size
+    log_f = np.log10(sel_f)
+    centre = log_f.mean()
+    x = log_f - centre
+    y = np.log10(sel_p)
+    # Break k lies between bins k - 1 and k, k = width .. count - width.
+    breaks = np.arange(width, count - width + 1)
+    x_break = np.log10(0.5 * (sel_f[breaks - 1] + sel_f[breaks])) - centre
+    below = _line_at(x, y, width, np.pad(x_break, (0, width)))[breaks - width]
+    above = _line_at(x, y, width, np.pad(x_break, (width, 0)))[breaks]
+    return breaks, above - below
 
 
 def level_change_frequency(f: ArrayLike, p: ArrayLike,
@@ -393,45 +443,17 @@ def level_change_frequency(f: ArrayLike, p: ArrayLike,
 
     Raises
     ------
-    ValueError
+    ScenarioError
         For invalid spectra or band, p or f not > 0 in the band, an unknown
         direction or a window that does not fit twice into the band.
 
     """
     freq, psd = _spectrum(f, p)
     if direction not in _DIRECTIONS:
-        raise ValueError(f"direction must be one of 'either', 'down', 'up', got {direction!r}")
-    index = _band(freq, band)
-    if band is None:
-        index = index[freq[index] > 0.0]
-    sel_f, sel_p = freq[index], psd[index]
-    if sel_f[0] <= 0.0 or np.any(sel_p <= 0.0):
-        raise ValueError(
-            f'f and p must be > 0 inside band {band!r}, got f from {sel_f[0]!r} Hz and '
-            f'minimum p {sel_p.min()!r}')
-    count = sel_f.size
-    if window_bins is None:
-        width = max(MIN_WINDOW_BINS, count // 8)
-    elif isinstance(window_bins, bool) or not isinstance(window_bins, (int, np.integer)) \
-            or window_bins < MIN_WINDOW_BINS:
-        raise ValueError(
-            f'window_bins must be an integer >= {MIN_WINDOW_BINS}, got {window_bins!r}')
-    else:
-        width = int(window_bins)
-    if count < 2 * width:
-        raise ValueError(
-            f'band {band!r} must hold at least 2 * window_bins = {2 * width} bins, '
-            f'got {count}')
-    log_f = np.log10(sel_f)
-    centre = log_f.mean()
-    x = log_f - centre
-    y = np.log10(sel_p)
-    # Break k lies between bins k - 1 and k, k = width .. count - width.
-    breaks = np.arange(width, count - width + 1)
-    x_break = np.log10(0.5 * (sel_f[breaks - 1] + sel_f[breaks])) - centre
-    below = _line_at(x, y, width, np.pad(x_break, (0, width)))[breaks - width]
-    above = _line_at(x, y, width, np.pad(x_break, (width, 0)))[breaks]
-    step = above - below
+        raise ScenarioError(f"direction must be one of 'either', 'down', 'up', got {direction!r}")
+    sel_f, sel_p = _positive_band(freq, psd, band)
+    width = _window_width(window_bins, sel_f.size, band)
+    breaks, step = _level_steps(sel_f, sel_p, width)
     if direction == 'down':
         j = int(np.argmin(step))
     elif direction == 'up':

@@ -36,6 +36,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ttb_sim.analysis.levels import band_sums, line_power, third_octave_bands
+from ttb_sim.errors import ScenarioError
 
 __all__ = ['CAR_BODY_LIMITS', 'GRAVITY', 'SPERLING_GRADES', 'sperling_correction',
            'sperling_index', 'sperling_grade']
@@ -57,7 +58,7 @@ def sperling_correction(f: ArrayLike, direction: str = 'vertical') -> NDArray[np
     elif direction == 'lateral':
         knee, top, a, b = 5.4, 26.0, 0.8, 650.0
     else:
-        raise ValueError(f"direction must be 'vertical' or 'lateral', got {direction!r}")
+        raise ScenarioError(f"direction must be 'vertical' or 'lateral', got {direction!r}")
     with np.errstate(divide='ignore'):
         out = np.where(freq < knee, a * freq**2, np.where(freq < top, b / freq**2, 1.0))
     return np.asarray(np.where(freq < 0.5, 0.0, out), dtype=float)

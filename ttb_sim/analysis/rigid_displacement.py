@@ -26,6 +26,8 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from ttb_sim.errors import ScenarioError
+
 __all__ = ['rigid_midspan_displacement']
 
 
@@ -45,7 +47,7 @@ def rigid_midspan_displacement(left_piles: ArrayLike | None, right_piles: ArrayL
                                                                           right_piles)]
     given = [g for g in groups if g is not None]
     if not given:
-        raise ValueError('rigid_midspan_displacement needs the piles of at least one support')
+        raise ScenarioError('rigid_midspan_displacement needs the piles of at least one support')
     n = given[0].shape[0]
     means = []
     for g in groups:
@@ -53,7 +55,7 @@ def rigid_midspan_displacement(left_piles: ArrayLike | None, right_piles: ArrayL
             means.append(np.zeros(n))
             continue
         if g.ndim != 2 or g.shape[0] != n or g.shape[1] == 0:
-            raise ValueError(f'pile displacements must be (samples, piles) with {n} samples, '
-                             f'got shape {g.shape}')
+            raise ScenarioError(f'pile displacements must be (samples, piles) with {n} samples, '
+                                f'got shape {g.shape}')
         means.append(g.mean(axis=1))
     return np.asarray(0.5 * (means[0] + means[1]), dtype=float)

@@ -37,6 +37,8 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy import signal as ssig
 
+from ttb_sim.errors import ScenarioError
+
 __all__ = ['LIMITS', 'deck_acceleration', 'derailment_coefficient', 'lateral_force_limit',
            'wheel_load_reduction']
 
@@ -100,8 +102,8 @@ def deck_acceleration(displacement: ArrayLike, sample_rate: float,
     """
     u = np.asarray(displacement, dtype=float)
     if u.ndim != 1 or u.size < 4:
-        raise ValueError(f'displacement must be a 1-D array of at least 4 samples, '
-                         f'got shape {u.shape}')
+        raise ScenarioError(f'displacement must be a 1-D array of at least 4 samples, '
+                            f'got shape {u.shape}')
     dt = 1.0 / sample_rate
     a = np.gradient(np.gradient(u, dt, edge_order=2), dt, edge_order=2)
     if cutoff < 0.5 * sample_rate and u.size > 27:

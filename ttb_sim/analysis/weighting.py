@@ -33,6 +33,8 @@ import math
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from ttb_sim.errors import ScenarioError
+
 __all__ = ['WEIGHTINGS', 'Weighting', 'weighted_rms', 'weighting_db', 'weighting_response']
 
 
@@ -64,7 +66,7 @@ def _weighting(name: str | Weighting) -> Weighting:
     if isinstance(name, Weighting):
         return name
     if name not in WEIGHTINGS:
-        raise ValueError(f'weighting must be one of {", ".join(WEIGHTINGS)}, got {name!r}')
+        raise ScenarioError(f'weighting must be one of {", ".join(WEIGHTINGS)}, got {name!r}')
     return WEIGHTINGS[name]
 
 
@@ -106,9 +108,9 @@ def weighted_rms(signal: ArrayLike, sample_rate: float, name: str | Weighting = 
     """
     x = np.asarray(signal, dtype=float)
     if x.ndim != 1 or x.size < 2:
-        raise ValueError(f'signal must be a 1-D array of at least 2 samples, got {x.shape}')
+        raise ScenarioError(f'signal must be a 1-D array of at least 2 samples, got {x.shape}')
     if not (math.isfinite(sample_rate) and sample_rate > 0):
-        raise ValueError(f'sample_rate must be > 0, got {sample_rate!r}')
+        raise ScenarioError(f'sample_rate must be > 0, got {sample_rate!r}')
     spectrum = np.fft.rfft(x - x.mean())
     f = np.fft.rfftfreq(x.size, 1.0 / sample_rate)
     power = np.abs(spectrum * weighting_response(f, name))**2

@@ -13,9 +13,12 @@
 # limitations under the License.
 
 """
-The ROS-free verbs of ``ttb-sim``: run, validate, scenarios, bench.
+The ROS-free verbs of ``ttb-sim``: run, validate, scenarios, bench, modes, analyze, compare, sweep.
 
-Each verb is a function that takes plain arguments, prints what a user reads and
-returns the exit code; ``cli.py`` only parses arguments and maps errors to exit
-codes, and tests call the verbs directly.
+Each verb is a function that takes plain arguments, calls the libraries, prints
+what a user reads and returns the exit code; ``cli.py`` only parses arguments and
+maps errors to exit codes, and tests call the verbs directly.  Beside the verbs:
+``signals`` (SIGINT / SIGTERM for the command line and the verbs), ``bench_runs``
+(one measured run of ``bench``) and ``sweep_case`` (one case of ``sweep``).  The
+reports of bags are the library :mod:`ttb_sim.report`.
 """

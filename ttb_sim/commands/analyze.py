@@ -17,7 +17,7 @@ The ``analyze`` verb: one bag -> figures, ``metrics.json`` and ``index.html``.
 
 The bag is read and every metric computed before the output folder is
 touched; figures are written into a staging folder renamed into place at the
-end (:func:`ttb_sim.commands.report_html.staged_output`), so a failure leaves no
+end (:func:`ttb_sim.report.output.staged_output`), so a failure leaves no
 folder that looks complete.
 """
 
@@ -28,10 +28,10 @@ from pathlib import Path
 import sys
 import time
 
-from ttb_sim.commands.report import bag_metrics
-from ttb_sim.commands.report_figures import write_figures
-from ttb_sim.commands.report_html import check_output, staged_output, write_index, write_json
-from ttb_sim.commands.streams import load_streams
+from ttb_sim.io.streams import load_streams
+from ttb_sim.report.figures import write_figures
+from ttb_sim.report.metrics import bag_metrics
+from ttb_sim.report.output import check_output, staged_output, write_index, write_json
 
 log = logging.getLogger(__name__)
 

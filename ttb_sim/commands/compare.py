@@ -29,57 +29,18 @@ import logging
 from pathlib import Path
 import sys
 import time
-from typing import Any, Sequence
+from typing import Sequence
 
-from ttb_sim.commands.report import bag_metrics
-from ttb_sim.commands.report_figures import write_figures
-from ttb_sim.commands.report_html import check_output, staged_output, write_index, write_json
-from ttb_sim.commands.streams import load_streams
 from ttb_sim.errors import ScenarioError
 from ttb_sim.io.bag import default_bag_path
+from ttb_sim.io.streams import load_streams
+from ttb_sim.report.figures import write_figures
+from ttb_sim.report.metrics import bag_metrics, differences
+from ttb_sim.report.output import check_output, staged_output, write_index, write_json
 
 log = logging.getLogger(__name__)
 
 EXIT_OK = 0
-
-
-def flatten(metrics: dict[str, Any], prefix: str = '') -> dict[str, float]:
-    """Return the numeric leaves of a metrics tree as {'a.b.c': value} (lists left out)."""
-    out: dict[str, float] = {}
-    for key, value in metrics.items():
-        name = f'{prefix}{key}'
-        if isinstance(value, dict):
-            out.update(flatten(value, name + '.'))
-        elif isinstance(value, (int, float)) and not isinstance(value, bool):
-            out[name] = float(value)
-    return out
-
-
-def differences(labels: Sequence[str], metrics: Sequence[dict[str, Any]]) -> list[list[Any]]:
-    """
-    Return rows (metric, value per bag, then per other bag: difference and relative difference).
-
-    Differences are against the first bag; the relative one is None where the
-    first bag's value is 0. Bookkeeping numbers (durations, rates, times) are left out.
-    """
-    flat = [flatten({k: v for k, v in m.items()
-                     if k not in ('analysis_time_s', 'duration_s', 'sample_rate_hz',
-                                  'excitation_hz')}) for m in metrics]
-    keys: list[str] = []
-    for f in flat:
-        keys.extend(k for k in f if k not in keys and not k.endswith('.limit'))
-    rows = []
-    for key in keys:
-        values = [f.get(key) for f in flat]
-        row: list[Any] = [key, *values]
-        base = values[0]
-        for v in values[1:]:
-            if base is None or v is None:
-                row.extend([None, None])
-            else:
-                row.extend([v - base, (v - base) / abs(base) if base else None])
-        rows.append(row)
-    return rows
 
 
 def _labels(bags: Sequence[Path], labels: str | Sequence[str] | None) -> list[str]:

@@ -80,7 +80,7 @@ def modes_report(scenario: str | Path, *, around: float = 5.0, count: int = 20,
         loaded = load_scenario(scenario, [*overrides, 'solver.coupling=monolithic',
                                           'solver.substructure_steps=1'])
     from ttb_sim.model.modes import natural_modes
-    from ttb_sim.sim.build import build_structure
+    from ttb_sim.sim import build_structure
 
     structure = build_structure(loaded)
     found = natural_modes(structure.mass, structure.stiffness, structure.damping, around,

@@ -25,63 +25,23 @@ from __future__ import annotations
 from dataclasses import dataclass
 import json
 import logging
-import os
 from pathlib import Path
 import signal
 import sys
 import time
-from typing import Any, Callable, NoReturn, Sequence
+from typing import Any, Callable, Sequence
 
 from ttb_sim import __version__
+from ttb_sim.commands.signals import signal_name, SignalHandlers, StopFlag
 from ttb_sim.config import load_scenario, Scenario
 from ttb_sim.errors import SimulationError
 from ttb_sim.io.bag import BagRecorder, check_destination, default_bag_path, make_parents
-from ttb_sim.io.topics import PeakTracker, topic_table
-from ttb_sim.sim.cost import CostEstimate, STEP_BUDGET
-from ttb_sim.sim.runner import make_runner, Runner
+from ttb_sim.io.topics import PeakTracker, Topic, topic_table
+from ttb_sim.sim import CostEstimate, make_runner, Runner, STEP_BUDGET
 
 log = logging.getLogger(__name__)
 
 EXIT_OK, EXIT_FAILURE = 0, 1
-
-
-class StopFlag:
-    """
-    Signal handler for SIGINT / SIGTERM, installed before set-up.
-
-    During set-up (:attr:`setup` True) nothing has been written, so a signal
-    ends the process at once with one line on stderr and exit 128 + signal
-    (:func:`exit_on_signal`): no exception has to unwind through half-imported
-    extension modules or a factorisation. Once recording starts (:attr:`setup`
-    False) a signal only sets the flag, which the run loop polls between
-    frames, so that no message is ever half-written.
-    """
-
-    def __init__(self) -> None:
-        self.signal: int | None = None
-        self.setup = True
-
-    def __call__(self, signum: int, frame: object) -> None:
-        if self.setup:
-            exit_on_signal(signum, 'during set-up; nothing written')
-        self.signal = signum
-
-    def __bool__(self) -> bool:
-        return self.signal is not None
-
-
-def exit_on_signal(signum: int, detail: str) -> NoReturn:
-    """Write 'ttb-sim: stopped by SIGNAME <detail>' to stderr; end the process (128 + signum)."""
-    os.write(2, f'ttb-sim: stopped by {signal_name(signum)} {detail}\n'.encode())
-    os._exit(128 + signum)
-
-
-def signal_name(signum: int | None) -> str:
-    """Return 'SIGINT', 'SIGTERM', ... for a signal number."""
-    try:
-        return signal.Signals(signum).name if signum else 'a signal'
-    except ValueError:
-        return f'signal {signum}'
 
 
 @dataclass
@@ -113,7 +73,7 @@ def run_to_bag(scenario: Scenario, out: Path, storage: str = 'mcap',
     progress : callable, optional
         Called with the number of frames written since the last call.
     simulation : Runner, optional
-        An already built model of ``scenario`` (:func:`~ttb_sim.sim.runner.make_runner`).
+        An already built model of ``scenario`` (:func:`~ttb_sim.sim.make_runner`).
     should_stop : callable, optional
         Polled between frames; when it returns True the run stops cleanly with
         status 'interrupted' (signal handlers set such a flag, so that no
@@ -147,51 +107,68 @@ def run_to_bag(scenario: Scenario, out: Path, storage: str = 'mcap',
     estimate = estimate or sim.plan(len(topics))
     peaks = PeakTracker(topics)
     make_parents(out)
-    status, message, frames, last_time = 'ok', '', 0, 0.0
+    done = _Progress()
     start = time.perf_counter()
     try:
         with BagRecorder(out, topics, storage) as bag:
             for frame in sim.frames():
                 bag.write(frame)
                 peaks.update(frame)
-                frames += 1
-                last_time = frame.time
+                done.frames += 1
+                done.last_time = frame.time
                 if progress is not None:
                     progress(1)
                 if should_stop is not None and should_stop():
-                    status, message = 'interrupted', 'stopped by a signal'
+                    done.status, done.message = 'interrupted', 'stopped by a signal'
                     break
     except SimulationError as exc:  # divergence, interface iterations that fail
-        status, message = 'diverged', str(exc)
+        done.status, done.message = 'diverged', str(exc)
     except KeyboardInterrupt:
-        status, message = 'interrupted', 'interrupted by a signal'
+        done.status, done.message = 'interrupted', 'interrupted by a signal'
         raise
     finally:
-        stepping = time.perf_counter() - start
-        wall = setup_time + stepping
-        summary = {
-            'ttb_sim_version': __version__,
-            'status': status,
-            'message': message,
-            'scenario': scenario.echo(),
-            'bag': {'path': str(out), 'storage': storage,
-                    'topics': [t.full_name() for t in topics]},
-            'solver': {'dt': sim.dt, 'steps_planned': sim.n_steps,
-                       'duration_planned': sim.duration, 'free_dofs': sim.n_free,
-                       'output_every_steps': sim.output_every, **sim.describe()},
-            'frames': frames,
-            'simulated_time': last_time,
-            'estimate': estimate.as_dict(),
-            'setup_time': setup_time,
-            'stepping_time': stepping,
-            'wall_time': wall,
-            'real_time_factor': last_time / wall if wall > 0 else None,
-            'peaks': peaks.summary(),
-        }
+        summary = _summary(scenario, sim, out, storage, topics, estimate, peaks, done,
+                           setup_time, time.perf_counter() - start)
         if out.is_dir():
             (out / 'summary.json').write_text(json.dumps(summary, indent=2) + '\n',
                                               encoding='utf-8')
-    return RunResult(path=out, status=status, summary=summary)
+    return RunResult(path=out, status=done.status, summary=summary)
+
+
+@dataclass
+class _Progress:
+    """How far a run got: its status and message, the frames written, the last frame's time."""
+
+    status: str = 'ok'
+    message: str = ''
+    frames: int = 0
+    last_time: float = 0.0
+
+
+def _summary(scenario: Scenario, sim: Runner, out: Path, storage: str, topics: Sequence[Topic],
+             estimate: CostEstimate, peaks: PeakTracker, done: _Progress, setup_time: float,
+             stepping: float) -> dict[str, Any]:
+    """Return the contents of ``summary.json``."""
+    wall = setup_time + stepping
+    return {
+        'ttb_sim_version': __version__,
+        'status': done.status,
+        'message': done.message,
+        'scenario': scenario.echo(),
+        'bag': {'path': str(out), 'storage': storage,
+                'topics': [t.full_name() for t in topics]},
+        'solver': {'dt': sim.dt, 'steps_planned': sim.n_steps,
+                   'duration_planned': sim.duration, 'free_dofs': sim.n_free,
+                   'output_every_steps': sim.output_every, **sim.describe()},
+        'frames': done.frames,
+        'simulated_time': done.last_time,
+        'estimate': estimate.as_dict(),
+        'setup_time': setup_time,
+        'stepping_time': stepping,
+        'wall_time': wall,
+        'real_time_factor': done.last_time / wall if wall > 0 else None,
+        'peaks': peaks.summary(),
+    }
 
 
 def run(scenario: str | Path, *, out: Path | None = None, storage: str = 'mcap',
@@ -213,7 +190,7 @@ def run(scenario: str | Path, *, out: Path | None = None, storage: str = 'mcap',
     speed_kmh, duration
         Shortcuts for ``train.speed_kmh`` and ``solver.duration``.
     force
-        Run even above the step budget (:data:`~ttb_sim.sim.cost.STEP_BUDGET`).
+        Run even above the step budget (:data:`~ttb_sim.sim.STEP_BUDGET`).
 
     Raises
     ------
@@ -224,7 +201,8 @@ def run(scenario: str | Path, *, out: Path | None = None, storage: str = 'mcap',
     """
     start = time.perf_counter()
     stop = StopFlag()
-    previous = {sig: signal.signal(sig, stop) for sig in (signal.SIGINT, signal.SIGTERM)}
+    handlers = SignalHandlers()
+    handlers.install(stop)
     bar = None
     try:
         loaded, out, simulation = _set_up(scenario, out, storage, overrides, speed_kmh,
@@ -241,8 +219,7 @@ def run(scenario: str | Path, *, out: Path | None = None, storage: str = 'mcap',
                             simulation=simulation, should_stop=stop.__bool__,
                             setup_time=time.perf_counter() - start, estimate=estimate)
     finally:
-        for sig, handler in previous.items():
-            signal.signal(sig, handler)
+        handlers.restore()
         if bar is not None:
             bar.close()
     s = result.summary

@@ -45,10 +45,11 @@ import threading
 import time
 from typing import Any, Callable, Iterator, Sequence
 
-from ttb_sim.commands.report_html import write_json
+from ttb_sim.commands.signals import raise_stopped, signal_name, SignalHandlers, Stopped
 from ttb_sim.commands.sweep_case import case_row, CaseSpec, is_finished, run_case
 from ttb_sim.config import load_scenario
 from ttb_sim.errors import ScenarioError
+from ttb_sim.report.output import write_json
 
 log = logging.getLogger(__name__)
 
@@ -132,18 +133,6 @@ def _start_worker(workers: int) -> None:
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     if workers > 1:
         os.environ['NUMBA_NUM_THREADS'] = '1'
-
-
-class _Stopped(Exception):
-    """SIGINT or SIGTERM arrived while cases ran."""
-
-    def __init__(self, signum: int) -> None:
-        super().__init__(signum)
-        self.signum = signum
-
-
-def _raise_stopped(signum: int, frame: object) -> None:
-    raise _Stopped(signum)
 
 
 class _Local:
@@ -267,16 +256,14 @@ def sweep(scenario: str, *, speeds_kmh: str, seeds: int | None = None,
     if todo:
         print(f'ttb-sim: sweep: running {len(todo)} cases on {where}', file=sys.stderr)
     main_thread = threading.current_thread() is threading.main_thread()
-    previous: dict[int, Any] = {}
+    handlers = SignalHandlers()
     if main_thread:   # workers start with Ctrl-C ignored (inherited): the parent handles it
-        previous[signal.SIGINT] = signal.signal(signal.SIGINT, signal.SIG_IGN)
+        handlers.install(signal.SIG_IGN, (signal.SIGINT,))
     try:
         if runner is not None:
             runner.submit(todo)
         if main_thread:
-            for sig in (signal.SIGINT, signal.SIGTERM):
-                handler = signal.signal(sig, _raise_stopped)
-                previous.setdefault(sig, handler)
+            handlers.install(raise_stopped)
         for i, (case, record) in enumerate(runner.results() if runner else [], start=1):
             records[case.name] = record
             detail = f'in {record.get("wall_time_s", 0.0) or 0.0:.1f} s' \
@@ -285,19 +272,17 @@ def sweep(scenario: str, *, speeds_kmh: str, seeds: int | None = None,
                   file=sys.stderr, flush=True)
         if runner is not None:
             runner.close()
-    except _Stopped as stop:
+    except Stopped as stop:
         if runner is not None:
             runner.stop()
-        name = 'SIGTERM' if stop.signum == signal.SIGTERM else 'SIGINT'
-        print(f'ttb-sim: stopped by {name}; {len(records)} of {len(cases)} cases finished in '
-              f'{target} (rerun the same command to resume)', file=sys.stderr)
+        print(f'ttb-sim: stopped by {signal_name(stop.signum)}; {len(records)} of {len(cases)} '
+              f'cases finished in {target} (rerun the same command to resume)', file=sys.stderr)
         return 128 + stop.signum
     finally:
-        for signum, handler in previous.items():
-            signal.signal(signum, handler)
+        handlers.restore()
     rows = [case_row(records[c.name]) for c in cases if c.name in records]
     _write_csv(target / 'sweep.csv', rows)
-    from ttb_sim.commands.sweep_figures import sweep_figures
+    from ttb_sim.report.sweep_figures import sweep_figures
     figures = sweep_figures(rows, target)
     failed = [r['case'] for r in rows if r['status'] != 'ok']
     print(f'{target}: {len(cases)} cases ({len(done)} skipped as finished, '

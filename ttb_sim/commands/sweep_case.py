@@ -80,13 +80,12 @@ def run_case(spec: CaseSpec) -> dict[str, Any]:
     Never raises for a failing case: the record has ``status`` 'failed' or
     'diverged' and the error message, and no ``case.json`` is written.
     """
-    from ttb_sim.commands.report import bag_metrics
-    from ttb_sim.commands.report_html import write_json
     from ttb_sim.commands.run import run_to_bag
-    from ttb_sim.commands.streams import load_streams
     from ttb_sim.config import load_scenario
-    from ttb_sim.sim.simulation import Simulation
-    from ttb_sim.sim.cost import STEP_BUDGET
+    from ttb_sim.io.streams import load_streams
+    from ttb_sim.report.metrics import bag_metrics
+    from ttb_sim.report.output import write_json
+    from ttb_sim.sim import Simulation, STEP_BUDGET
 
     start = time.perf_counter()
     folder = Path(spec.folder)

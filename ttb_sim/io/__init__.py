@@ -13,16 +13,20 @@
 # limitations under the License.
 
 """
-Input and output: the topic table, the rosbag2 recorder and the bag reader.
+Input and output: the topic table, the rosbag2 recorder, the bag reader and the bag's streams.
 
 ``topics`` maps frames to standard ROS 2 messages (one table for the node and the
 bags), ``bag`` records frames to rosbag2 (MCAP or SQLite 3), ``reader`` reads any
-bag of ours back into numpy arrays per topic.
+bag of ours back into numpy arrays per topic, ``streams`` sorts those arrays into
+named, evenly sampled streams (car bodies, wheel-rail forces, girders, piles, soil)
+for the reports.
 """
 
 from ttb_sim.io.bag import BagRecorder, default_bag_path, STORAGES
 from ttb_sim.io.reader import bag_topics, read_bag, TopicArrays
+from ttb_sim.io.streams import load_streams, Series, Streams
 from ttb_sim.io.topics import FRAME_ID, NAMESPACE, PeakTracker, Topic, topic_table
 
-__all__ = ['bag_topics', 'BagRecorder', 'default_bag_path', 'FRAME_ID', 'NAMESPACE',
-           'PeakTracker', 'read_bag', 'STORAGES', 'Topic', 'topic_table', 'TopicArrays']
+__all__ = ['bag_topics', 'BagRecorder', 'default_bag_path', 'FRAME_ID', 'load_streams',
+           'NAMESPACE', 'PeakTracker', 'read_bag', 'Series', 'STORAGES', 'Streams', 'Topic',
+           'topic_table', 'TopicArrays']

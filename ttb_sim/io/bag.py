@@ -26,11 +26,11 @@ from typing import Any, Sequence
 
 from rosbags.rosbag2 import StoragePlugin, Writer
 from rosbags.rosbag2.errors import WriterError
-from rosbags.typesys import get_typestore, Stores
 from ttb_sim.errors import ScenarioError
 from ttb_sim.inputs import shown
+from ttb_sim.io.cdr import typestore
 from ttb_sim.io.topics import NAMESPACE, Topic
-from ttb_sim.sim.frames import Frame
+from ttb_sim.sim import Frame
 
 STORAGES = {'mcap': StoragePlugin.MCAP, 'sqlite3': StoragePlugin.SQLITE3}
 """Storage back-ends by their rosbag2 plugin names."""
@@ -155,11 +155,6 @@ def default_bag_path(name: str, root: Path = Path('runs')) -> Path:
         k += 1
         path = stem.with_name(f'{stem.name}-{k}')
     return path
-
-
-def typestore() -> Any:
-    """Return the rosbags type store of ROS 2 Jazzy."""
-    return get_typestore(Stores.ROS2_JAZZY)
 
 
 class BagRecorder:

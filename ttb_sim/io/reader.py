@@ -52,9 +52,10 @@ when asked for by name.
 Messages are decoded without a Python call per message where the bytes allow:
 messages of a topic whose strings and sequences have the same lengths share one
 CDR layout, so each field is one strided column of a ``(messages, bytes)``
-array; the layout is computed from the type definitions of the rosbags type
-store for ROS 2 Jazzy. Any other message (another layout, big-endian CDR) is
-deserialised by rosbags one by one, with the same result.
+array (:mod:`ttb_sim.io.cdr`: the layout is computed from the type definitions
+of the rosbags type store for ROS 2 Jazzy). Any other message (another layout,
+big-endian CDR) is deserialised by rosbags one by one, with the same result.
+This module flattens the decoded fields per message type.
 """
 
 from __future__ import annotations
@@ -64,13 +65,12 @@ from contextlib import contextmanager
 from dataclasses import dataclass
 import logging
 from pathlib import Path
-from typing import Any, Callable, Iterable, Iterator, Mapping, Sequence
+from typing import Any, Iterable, Iterator, Mapping, Sequence
 
 import numpy as np
 from rosbags.rosbag2 import Reader, ReaderError
-from rosbags.typesys.store import Nodetype
 from ttb_sim.errors import BagError
-from ttb_sim.io.bag import typestore
+from ttb_sim.io.cdr import Group, groups, typestore
 
 log = logging.getLogger(__name__)
 
@@ -96,11 +96,6 @@ DIAGNOSTICS = 'diagnostic_msgs/msg/DiagnosticArray'
 
 SUPPORTED_TYPES = (*_FLAT, POINT_CLOUD, DIAGNOSTICS)
 """Message types :func:`read_bag` flattens."""
-
-_PRIMITIVES = {'bool': '<u1', 'byte': '<u1', 'char': '<u1', 'int8': '<i1', 'uint8': '<u1',
-               'int16': '<i2', 'uint16': '<u2', 'int32': '<i4', 'uint32': '<u4',
-               'int64': '<i8', 'uint64': '<u8', 'float32': '<f4', 'float64': '<f8'}
-"""ROS primitive type -> little-endian numpy dtype."""
 
 _POINT_FIELD_TYPES = {1: 'i1', 2: 'u1', 3: 'i2', 4: 'u2', 5: 'i4', 6: 'u4', 7: 'f4', 8: 'f8'}
 """``sensor_msgs/msg/PointField`` datatype -> numpy dtype (without byte order)."""
@@ -322,166 +317,6 @@ def _select(path: Path, available: Mapping[str, str],
     return [t for t in available if t in chosen]
 
 
-# -- CDR layout ---------------------------------------------------------------------------
-
-class _NoLayout(Exception):
-    """The message cannot be decoded by layout (the per-message path takes it)."""
-
-
-@dataclass(frozen=True)
-class _Leaf:
-    """A primitive value or a block of primitives at a fixed byte offset."""
-
-    offset: int
-    dtype: str
-    count: int | None   # None: one scalar; else the number of elements
-
-
-class _Layout:
-    """
-    Byte offsets of every primitive of one little-endian CDR message.
-
-    ``prefixes`` are the offsets of the uint32 lengths of strings and
-    sequences; messages of the same size that agree there share the layout.
-    """
-
-    def __init__(self, store: Any, msgtype: str, data: bytes) -> None:
-        if len(data) < 4 or data[1] != 1:   # encapsulation: CDR little-endian only
-            raise _NoLayout
-        self._defs = store.fielddefs
-        self._data = data
-        self.pos = 4
-        self.leaves: dict[str, _Leaf] = {}
-        self.prefixes: list[int] = []
-        self._message(msgtype, '')
-        if not 0 <= len(data) - self.pos < 4:
-            raise _NoLayout
-
-    def _align(self, size: int) -> None:
-        self.pos += -(self.pos - 4) % size
-
-    def _uint32(self) -> int:
-        self._align(4)
-        if self.pos + 4 > len(self._data):
-            raise _NoLayout
-        self.prefixes.append(self.pos)
-        value = int.from_bytes(self._data[self.pos:self.pos + 4], 'little')
-        self.pos += 4
-        return value
-
-    def _message(self, msgtype: str, prefix: str) -> None:
-        for name, (nodetype, desc) in self._defs[msgtype][1]:
-            self._node(nodetype, desc, prefix + name)
-
-    def _node(self, nodetype: int, desc: Any, path: str) -> None:
-        if nodetype == Nodetype.BASE:
-            self._base(desc[0], path)
-        elif nodetype == Nodetype.NAME:
-            self._message(desc, path + '.')
-        elif nodetype == Nodetype.ARRAY:
-            self._elements(desc[0], desc[1], path)
-        else:
-            self._elements(desc[0], self._uint32(), path)
-
-    def _elements(self, sub: tuple[int, Any], count: int, path: str) -> None:
-        nodetype, desc = sub
-        if nodetype == Nodetype.BASE and desc[0] in _PRIMITIVES:
-            dtype = _PRIMITIVES[desc[0]]
-            size = int(dtype[2])
-            if count:
-                self._align(size)
-            self.leaves[path] = _Leaf(self.pos, dtype, count)
-            self.pos += size * count
-        else:
-            for i in range(count):
-                self._node(nodetype, desc, f'{path}[{i}]')
-        if self.pos > len(self._data):
-            raise _NoLayout
-
-    def _base(self, typename: str, path: str) -> None:
-        if typename == 'string':
-            length = self._uint32()   # (not `pos += ...`: that reads pos before the call)
-            self.pos += length
-        elif typename in _PRIMITIVES:
-            dtype = _PRIMITIVES[typename]
-            self._align(int(dtype[2]))
-            self.leaves[path] = _Leaf(self.pos, dtype, None)
-            self.pos += int(dtype[2])
-        else:   # wstring and other exotic types
-            raise _NoLayout
-
-
-Getter = Callable[[str], np.ndarray]
-"""Message path -> values of a group of messages: (n,) for a scalar, (n, k) for a block."""
-
-
-def _block_getter(layout: _Layout, block: np.ndarray) -> Getter:
-    """Read paths from a (messages, bytes) array that shares one layout."""
-    def get(path: str) -> np.ndarray:
-        leaf = layout.leaves[path]
-        size = int(leaf.dtype[2])
-        count = 1 if leaf.count is None else leaf.count
-        columns = np.ascontiguousarray(block[:, leaf.offset:leaf.offset + size * count])
-        values = columns.view(leaf.dtype)
-        return values[:, 0] if leaf.count is None else values
-    return get
-
-
-def _message_getter(msg: Any) -> Getter:
-    """Read paths from one deserialised message (as a group of one)."""
-    def get(path: str) -> np.ndarray:
-        value = msg
-        for part in path.split('.'):
-            value = getattr(value, part)
-        return np.asarray(value)[None, ...]
-    return get
-
-
-@dataclass(frozen=True)
-class _Group:
-    """Messages of one topic read the same way: their indices, a getter, one of them."""
-
-    index: np.ndarray
-    get: Getter
-    sample: Callable[[], Any]   # the first message deserialised (for metadata)
-
-
-def _groups(store: Any, msgtype: str, raws: Sequence[bytes]) -> list[_Group]:
-    """Split a topic's messages into groups of one layout (plus single messages)."""
-    by_size: dict[int, list[int]] = defaultdict(list)
-    for i, data in enumerate(raws):
-        by_size[len(data)].append(i)
-    groups: list[_Group] = []
-    pending = [np.asarray(v, dtype=np.int64) for v in by_size.values()]
-    while pending:
-        index = pending.pop()
-        first = raws[int(index[0])]
-        sample = _deserializer(store, first, msgtype)
-        try:
-            layout = _Layout(store, msgtype, first)
-        except _NoLayout:
-            groups.append(_Group(index[:1], _message_getter(sample()), sample))
-            if len(index) > 1:
-                pending.append(index[1:])
-            continue
-        block = np.frombuffer(b''.join(raws[int(i)] for i in index),
-                              dtype=np.uint8).reshape(len(index), len(first))
-        same = np.ones(len(index), dtype=bool)
-        for p in layout.prefixes:
-            same &= np.all(block[:, p:p + 4] == block[0, p:p + 4], axis=1)
-        same &= block[:, 1] == 1
-        groups.append(_Group(index[same], _block_getter(layout, block[same]), sample))
-        if not same.all():
-            pending.append(index[~same])
-    return groups
-
-
-def _deserializer(store: Any, data: bytes, msgtype: str) -> Callable[[], Any]:
-    def sample() -> Any:
-        return store.deserialize_cdr(data, msgtype)
-    return sample
-
-
 # -- flattening -----------------------------------------------------------------------------
 
 Decoded = tuple[np.ndarray, dict[str, np.ndarray], dict[str, tuple[str, ...]]]
@@ -497,7 +332,7 @@ def _decode(store: Any, msgtype: str, raws: Sequence[bytes]) -> Decoded:
     fields: dict[str, np.ndarray] = {}
     components: dict[str, tuple[str, ...]] = {}
     clouds: list[tuple[np.ndarray, np.ndarray, tuple[str, ...]]] = []
-    for group in _groups(store, msgtype, raws):
+    for group in groups(store, msgtype, raws):
         stamp_ns[group.index] = (group.get(f'{stamp_path}.sec').astype(np.int64) * 1_000_000_000
                                  + group.get(f'{stamp_path}.nanosec').astype(np.int64))
         if msgtype == POINT_CLOUD:
@@ -519,7 +354,7 @@ def _decode(store: Any, msgtype: str, raws: Sequence[bytes]) -> Decoded:
     return stamp_ns, fields, components
 
 
-def _points(group: _Group) -> tuple[tuple[str, ...], np.ndarray]:
+def _points(group: Group) -> tuple[tuple[str, ...], np.ndarray]:
     """Return the field names and (messages, points, fields) values of a cloud group."""
     sample = group.sample()
     n_points = int(sample.width) * int(sample.height)

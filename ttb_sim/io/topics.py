@@ -32,7 +32,7 @@ from typing import Any, Callable, Sequence
 
 import numpy as np
 
-from ttb_sim.sim.frames import Frame, Layout
+from ttb_sim.sim import Frame, Layout
 
 MessageTypes = Callable[[str], Any]
 """Maps a ROS type name to its message class."""

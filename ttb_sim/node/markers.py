@@ -19,15 +19,18 @@ The RViz / Foxglove markers of ``~/model/markers``, described as plain data.
 :func:`model_markers` gives one :class:`Box` per girder, pier and abutment (or,
 for a pile-soil substructure run, per pile plus the soil block and the cap),
 :func:`train_markers` the car bodies and axles at a head position, and
-:func:`markers` the complete :class:`MarkerSet` that the node sends latched.
+:func:`markers` the complete :class:`MarkerSet` that the node sends latched;
+:func:`marker_array` copies a set into a ``visualization_msgs/msg/MarkerArray`` of
+the message classes it is given (rclpy's in the node).
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Any
 
 from ttb_sim.config import Scenario
-from ttb_sim.io.topics import FRAME_ID
+from ttb_sim.io.topics import FRAME_ID, MessageTypes
 
 
 @dataclass(frozen=True)
@@ -189,3 +192,40 @@ def train_markers(scenario: Scenario, head_position: float) -> list[Box]:
 def markers(scenario: Scenario, head_position: float) -> MarkerSet:
     """Return the complete marker set: structure and train (sent latched as a whole)."""
     return MarkerSet(tuple(model_markers(scenario) + train_markers(scenario, head_position)))
+
+
+def marker_array(types: MessageTypes, marker_set: MarkerSet) -> Any:
+    """
+    Copy a plain marker description into a ``visualization_msgs/msg/MarkerArray``.
+
+    Parameters
+    ----------
+    types : callable
+        Maps a ROS type name to its message class (rclpy's, whose fields have defaults).
+    marker_set : MarkerSet
+        Boxes in the track frame.
+
+    Returns
+    -------
+    MarkerArray
+        One CUBE marker per box, stamp zero (latest transform), never expiring.
+
+    """
+    marker = types('visualization_msgs/msg/Marker')
+    point, pose = types('geometry_msgs/msg/Point'), types('geometry_msgs/msg/Pose')
+    quaternion, vector3 = types('geometry_msgs/msg/Quaternion'), types('geometry_msgs/msg/Vector3')
+    color_rgba = types('std_msgs/msg/ColorRGBA')
+    stamp = types('builtin_interfaces/msg/Time')(sec=0, nanosec=0)
+    header = types('std_msgs/msg/Header')(stamp=stamp, frame_id=marker_set.frame_id or FRAME_ID)
+    out = []
+    for box in marker_set.boxes:
+        x, y, z = (float(v) for v in box.position)
+        sx, sy, sz = (float(v) for v in box.size)
+        r, g, b, a = (float(v) for v in box.color)
+        out.append(marker(header=header, ns=box.ns, id=box.marker_id, type=marker.CUBE,
+                          action=marker.ADD,
+                          pose=pose(position=point(x=x, y=y, z=z),
+                                    orientation=quaternion(x=0.0, y=0.0, z=0.0, w=1.0)),
+                          scale=vector3(x=sx, y=sy, z=sz),
+                          color=color_rgba(r=r, g=g, b=b, a=a), frame_locked=False))
+    return types('visualization_msgs/msg/MarkerArray')(markers=out)

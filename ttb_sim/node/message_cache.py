@@ -35,7 +35,7 @@ from __future__ import annotations
 from typing import Any, Callable, Sequence
 
 from ttb_sim.io.topics import MessageTypes, Topic
-from ttb_sim.sim.frames import Frame
+from ttb_sim.sim import Frame
 
 Updater = Callable[[list[float]], None]
 """Writes a topic's values (as Python floats) into its message."""

@@ -16,15 +16,19 @@
 """
 Passage control: the simulation stepping behind the live node, paced and recorded.
 
-:class:`PassageController` owns a :class:`~ttb_sim.sim.runner.Runner` (a train
+:class:`PassageController` owns a :class:`~ttb_sim.sim.Runner` (a train
 simulation, or a pile-soil substructure alone under its load),
 steps it paced by the real-time factor, hands every frame to a recorder (a
 :class:`FrameSink`) and the frames due for live publishing (``publish_rate_hz``
 of simulation time) to the caller as a :class:`Tick`, and handles speed
 changes, reset, pause, loop and divergence. :meth:`PassageController.diagnostics`
-reports solver health as a :class:`DiagnosticsReport` (plain data that the node
-copies into ``/diagnostics``); :func:`frame_values` gives a frame's headline
-values for it.
+reports solver health as a :class:`~ttb_sim.node.diagnostics.DiagnosticsReport`
+(plain data that the node copies into ``/diagnostics``).
+
+A runner that is a train passage (:class:`TrainRun`: a live speed, an exit position,
+a fundamental frequency) also takes speed changes, computes frames only at the
+publishing rate without a bag, and ends its passage once the train has left; a
+pile-soil substructure run steps its planned time.
 """
 
 from __future__ import annotations
@@ -34,15 +38,14 @@ import logging
 import math
 import threading
 import time
-from typing import Any, Callable, Iterator, Mapping, Protocol
+from typing import Any, Callable, Iterator, Mapping, Protocol, runtime_checkable
 
 from ttb_sim.config import Scenario
 from ttb_sim.errors import DivergenceError, TtbSimError
+from ttb_sim.node.diagnostics import DiagnosticsReport, frame_values, passage_level, StepMeter
 from ttb_sim.node.parameters import (IRREGULARITY_KEYS, normalize_value, parameter_table,
                                      SCENARIO_KEYS, scenario_with)
-from ttb_sim.sim.frames import Frame, Layout
-from ttb_sim.sim.runner import make_runner, Runner
-from ttb_sim.sim.simulation import Simulation
+from ttb_sim.sim import Frame, Layout, make_runner, Runner
 
 log = logging.getLogger(__name__)
 
@@ -51,6 +54,36 @@ MARKER_PERIOD = 0.1
 
 MAX_LAG = 0.5
 """Wall-clock seconds the stepping may fall behind its pace before the pace is re-anchored."""
+
+
+class _Structure(Protocol):
+    """What passage control reads of a train run's structure."""
+
+    @property
+    def fundamental_frequency(self) -> float:
+        """The first natural frequency of the track-bridge structure (Hz)."""
+
+
+@runtime_checkable
+class TrainRun(Runner, Protocol):
+    """
+    A :class:`~ttb_sim.sim.Runner` of a train passage: what passage control needs beyond it.
+
+    :class:`~ttb_sim.sim.Runner` has none of these (a pile-soil substructure run has no
+    train): a live speed change, the head position at which the train has left the
+    bridge, and the structure's fundamental frequency (the free-vibration tail).
+    """
+
+    @property
+    def structure(self) -> _Structure:
+        """The track-bridge structure."""
+
+    @property
+    def exit_position(self) -> float:
+        """Head position (m) at which the last axle leaves the bridge."""
+
+    def set_speed(self, speed: float) -> None:
+        """Change the train speed (m/s) from the next step on."""
 
 
 class FrameSink(Protocol):
@@ -89,34 +122,6 @@ class Tick:
     sleep: float = 0.0
     markers: bool = False
     events: list[str] = field(default_factory=list)
-
-
-@dataclass(frozen=True)
-class DiagnosticsReport:
-    """
-    Solver health for ``/diagnostics``, as plain data.
-
-    Attributes
-    ----------
-    level : int
-        0 OK, 1 WARN, 2 ERROR (the ``diagnostic_msgs/msg/DiagnosticStatus`` levels).
-    message : str
-        One line summary.
-    values : tuple of (str, str)
-        Key/value pairs; keys carry their unit.
-
-    """
-
-    level: int
-    message: str
-    values: tuple[tuple[str, str], ...]
-
-    def as_dict(self) -> dict[str, str]:
-        """Return the key/value pairs as a dict."""
-        return dict(self.values)
-
-
-OK, WARN, ERROR = 0, 1, 2
 
 
 class PassageController:
@@ -158,17 +163,13 @@ class PassageController:
         self.time_offset = 0.0
         self.last_frame: Frame | None = None
         self.sim: Runner
+        self._train: TrainRun | None = None   # self.sim when it is a train passage
         self._frames: Iterator[Frame]
         self._anchor: tuple[float, float] | None = None
         self._exit_time: float | None = None
         self._next_publish = 0.0
         self._last_markers = -math.inf
-        # wall, sim time, steps, stepping seconds (wall), stepping CPU seconds
-        self._window = (clock(), 0.0, 0, 0.0, 0.0)
-        self._sim_total = 0.0
-        self._steps_total = 0
-        self._stepping_total = 0.0
-        self._stepping_cpu = 0.0
+        self._meter = StepMeter(clock())
         self._base_every = 1
         self._start_passage()
 
@@ -192,8 +193,8 @@ class PassageController:
                 value = normalize_value(param, value)
             self.values[name] = value
             if name == 'train.speed_kmh':
-                if isinstance(self.sim, Simulation):
-                    self.sim.set_speed(value / 3.6)
+                if self._train is not None:
+                    self._train.set_speed(value / 3.6)
                 else:
                     log.info('train.speed_kmh has no effect on a substructure run')
             elif name == 'real_time_factor':   # the new pace counts from now
@@ -298,8 +299,7 @@ class PassageController:
                 self._step_one(tick)
                 if time.perf_counter() > deadline:
                     break
-            self._stepping_total += time.perf_counter() - started
-            self._stepping_cpu += time.thread_time() - started_cpu
+            self._meter.stepping(time.perf_counter() - started, time.thread_time() - started_cpu)
             if self.state == 'running' and rtf > 0:
                 due = wall0 + (self._node_time + self.frame_period - sim0) / rtf
                 lag = now - due
@@ -327,8 +327,7 @@ class PassageController:
         frame = replace(raw, time=self.time_offset + raw.time)
         self.last_frame = frame
         tick.stepped += 1
-        self._steps_total += self.sim.output_every
-        self._sim_total += self.frame_period if raw.step else 0.0
+        self._meter.frame(self.sim.output_every, self.frame_period if raw.step else 0.0)
         self._record(frame)
         period = self._publish_period()
         if frame.time >= self._next_publish - 1e-9:
@@ -349,8 +348,8 @@ class PassageController:
         (1 when the period is not a whole multiple, or 0 Hz: every frame). It is
         changed between frames only, so frame times stay exact.
         """
-        sim = self.sim
-        if not isinstance(sim, Simulation):
+        sim = self._train
+        if sim is None:
             return
         stride = 1
         period = self._publish_period()
@@ -373,14 +372,15 @@ class PassageController:
         position and the free-vibration tail (free_vibration_periods / f1) has
         elapsed since: so a speed change shortens or lengthens the passage.
         """
-        if self.base.solver.duration > 0 or not isinstance(self.sim, Simulation):
+        train = self._train
+        if self.base.solver.duration > 0 or train is None:
             return False
-        if raw.head_position < self.sim.exit_position:
+        if raw.head_position < train.exit_position:
             return False
         if self._exit_time is None:
             self._exit_time = raw.time
         tail = (self.base.solver.free_vibration_periods
-                / self.sim.structure.fundamental_frequency)
+                / train.structure.fundamental_frequency)
         return raw.time - self._exit_time >= tail - 1e-12
 
     def _end_passage(self, tick: Tick) -> None:
@@ -408,6 +408,7 @@ class PassageController:
         """Build a new simulation from the current parameters and start stepping it."""
         scenario = self.passage_scenario()
         self.sim = make_runner(scenario)
+        self._train = self.sim if isinstance(self.sim, TrainRun) else None
         self._base_every = self.sim.output_every
         self._frames = self.sim.frames()
         self._exit_time = None
@@ -460,27 +461,17 @@ class PassageController:
 
         """
         with self._lock:
-            now = self._clock()
-            wall0, sim0, steps0, busy0, cpu0 = self._window
-            self._window = (now, self._sim_total, self._steps_total, self._stepping_total,
-                            self._stepping_cpu)
-            cpu = self._stepping_cpu - cpu0
-            wall = now - wall0
-            sim_dt = self._sim_total - sim0
-            steps = self._steps_total - steps0
-            busy = self._stepping_total - busy0
-            rtf = sim_dt / wall if wall > 0 else 0.0
-            step_ms = 1e3 * busy / steps if steps else 0.0
+            window = self._meter.window(self._clock())
             target = float(self.values['real_time_factor'])
             values = [
                 ('state', self.state),
                 ('passage', str(self.passage)),
                 ('simulation time (s)', f'{self._node_time:.6f}'),
-                ('real-time factor', f'{rtf:.3g}'),
+                ('real-time factor', f'{window.real_time_factor:.3g}'),
                 ('real-time factor target (0 = max)', f'{target:g}'),
-                ('step time (ms)', f'{step_ms:.4f}'),
+                ('step time (ms)', f'{window.step_ms:.4f}'),
                 ('stepping CPU time per simulated second (s)',
-                 f'{cpu / sim_dt:.3f}' if sim_dt > 0 else '0'),
+                 f'{window.cpu / window.simulated:.3f}' if window.simulated > 0 else '0'),
                 ('solver dt (s)', f'{self.sim.dt:.6g}'),
                 ('contact iterations', '0'),  # the wheel-girder coupling is solved directly
                 ('divergence', self.divergence or 'none'),
@@ -491,18 +482,8 @@ class PassageController:
             ]
             if self.last_frame is not None:
                 values.extend(frame_values(self.last_frame))
-            if self.state == 'diverged':
-                level, message = ERROR, f'diverged: {self.divergence}'
-            elif self.state == 'failed':
-                level, message = ERROR, self.divergence
-            elif self.bag_error:
-                level, message = ERROR, self.bag_error
-            elif (self.state == 'running' and target > 0 and steps
-                  and rtf < 0.9 * target):
-                level, message = WARN, (f'slower than requested: real-time factor {rtf:.2f} '
-                                        f'< {target:g}')
-            else:
-                level, message = OK, f'{self.state}, passage {self.passage}'
+            level, message = passage_level(self.state, self.divergence, self.bag_error,
+                                           self.passage, target, window)
             return DiagnosticsReport(level, message, tuple(values))
 
     def _bag_state(self) -> str:
@@ -511,25 +492,3 @@ class PassageController:
         if self.recorder is not None:
             return 'recording'
         return 'closed' + (f' ({self.bag_error})' if self.bag_error else '')
-
-
-def frame_values(frame: Frame) -> list[tuple[str, str]]:
-    """
-    Return a frame's headline values as diagnostic key/value pairs (keys carry units).
-
-    Parameters
-    ----------
-    frame : Frame
-        The frame.
-
-    Returns
-    -------
-    list of (str, str)
-
-    """
-    out = [('head position (m)', f'{frame.head_position:.3f}'),
-           ('speed (m/s)', f'{frame.speed:.3f}'),
-           ('speed (km/h)', f'{frame.speed * 3.6:.2f}')]
-    for k, mid in enumerate(frame.midspan):
-        out.append((f'span{k + 1:02d} midspan z (m)', f'{float(mid[2]):.6g}'))
-    return out

@@ -49,7 +49,7 @@ import threading
 import time
 from typing import Callable, Sequence
 
-from ttb_sim.sim.frames import Frame
+from ttb_sim.sim import Frame
 
 log = logging.getLogger(__name__)
 

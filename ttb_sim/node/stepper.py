@@ -44,7 +44,7 @@ from ttb_sim.config import Scenario
 from ttb_sim.errors import TtbSimError
 from ttb_sim.node.parameters import normalize_value, parameter_table
 from ttb_sim.node.passage import FrameSink, PassageController, Tick
-from ttb_sim.sim.frames import Layout
+from ttb_sim.sim import Layout
 
 log = logging.getLogger(__name__)
 

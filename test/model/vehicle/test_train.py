@@ -26,7 +26,7 @@ import numpy as np
 import pytest
 from ttb_sim.config import load_scenario
 from ttb_sim.model.vehicle.train import Axles, MovingForces, MultibodyCars, QuarterCars
-from ttb_sim.sim.build import build_vehicle
+from ttb_sim.sim import build_vehicle
 
 
 def _quarter_cars(sprung, unsprung, stiffness):

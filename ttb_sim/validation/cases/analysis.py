@@ -33,7 +33,7 @@ import numpy as np
 from ttb_sim.analysis.power_flow import power_flow_spectrum, velocity_from_displacement
 from ttb_sim.analysis.weighting import weighting_response
 from ttb_sim.config import load_scenario
-from ttb_sim.sim.simulation import Simulation
+from ttb_sim.sim import Simulation
 from ttb_sim.validation.references.analysis import harmonic_power, time_mean_power, WK_TABLE
 from ttb_sim.validation.rows import Case, relative_row, Row
 

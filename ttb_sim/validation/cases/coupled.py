@@ -40,7 +40,7 @@ import numpy as np
 
 from ttb_sim.analysis.psd import padded_periodogram
 from ttb_sim.config import load_scenario, Scenario
-from ttb_sim.sim.simulation import Simulation
+from ttb_sim.sim import Simulation
 from ttb_sim.validation.rows import Case, Row
 
 COUPLING_TOLERANCE = 0.01

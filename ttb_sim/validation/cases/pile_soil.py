@@ -66,8 +66,8 @@ from ttb_sim.model.foundation.records import (BlockSize, EQUAL_AREA_SIDE, MeshSi
                                               PAPER_LAYERS, PileLoad, SoilLayer, SoilParameters,
                                               Substructure)
 from ttb_sim.model.foundation.substructure import build, PileSoilModel
-from ttb_sim.sim.frames import Frame
-from ttb_sim.sim.substructure import observe, states, static_solve, SubstructureRun
+from ttb_sim.sim import Frame, SubstructureRun
+from ttb_sim.sim.substructure import observe, states, static_solve
 from ttb_sim.validation.references.pile_soil import (hyperbola_stress, hyperbola_tangent,
                                                      layered_pile_stiffness,
                                                      quarter_wavelength_frequencies,

@@ -29,8 +29,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from ttb_sim.config import load_scenario, Scenario
-from ttb_sim.sim.integrators.newmark import Newmark
-from ttb_sim.sim.simulation import Simulation
+from ttb_sim.sim import Newmark, Simulation
 from ttb_sim.validation.cases.analysis import ANALYSIS_CASES
 from ttb_sim.validation.cases.components import COMPONENT_CASES
 from ttb_sim.validation.cases.coupled import COUPLED_CASES

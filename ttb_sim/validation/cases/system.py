@@ -38,8 +38,7 @@ import numpy as np
 
 from ttb_sim.analysis.psd import level_change_frequency, peak_frequency, welch_psd
 from ttb_sim.config import load_scenario
-from ttb_sim.sim.frames import Frame
-from ttb_sim.sim.simulation import Simulation
+from ttb_sim.sim import Frame, Simulation
 from ttb_sim.validation.rows import Case, relative_row, Row
 
 JUNCTION_WAVELENGTH = 1.0

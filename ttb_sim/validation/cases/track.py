@@ -18,7 +18,7 @@ Track validation cases V2 and V6 (VALIDATION.md) through the user pipeline.
 Both run the built-in scenario ``track_approach`` (one 42-DOF car, CHN60 rails
 as 3-D Euler beams, two elements per 0.63 m bay, on discrete fasteners on unit
 slabs; the car stays on the approach, where the base plate rests on rigid
-ground) through :class:`~ttb_sim.sim.simulation.Simulation` and read the
+ground) through :class:`~ttb_sim.sim.Simulation` and read the
 frames: rail observers (``output.observers``) for V2, wheel-rail forces for V6.
 The references are the closed forms of :mod:`ttb_sim.validation.references.track`
 (an infinite Euler beam on the smeared fasteners, k = k_v / s = 7.94e7 N/m^2,
@@ -115,7 +115,7 @@ from scipy.optimize import minimize_scalar
 from ttb_sim.analysis.psd import peak_frequency
 from ttb_sim.config import load_scenario, Scenario
 from ttb_sim.model.track import approach_length
-from ttb_sim.sim.simulation import Simulation
+from ttb_sim.sim import Simulation
 from ttb_sim.validation.references import track as tr
 from ttb_sim.validation.rows import Case, relative_row, Row
 

@@ -35,9 +35,10 @@ from ttb_sim.analysis.levels import vibration_levels
 from ttb_sim.analysis.psd import resolving_segment_seconds, welch_psd
 from ttb_sim.analysis.rigid_displacement import rigid_midspan_displacement
 from ttb_sim.analysis.safety import deck_acceleration
-from ttb_sim.commands.report import (bag_metrics, CAR_BODY_LOWEST_HZ, FigureNote, marks_of,
-                                     observer_stations, power_flows, soil_line, soil_val_points)
-from ttb_sim.commands.streams import Series, Streams
+from ttb_sim.io.streams import Series, Streams
+from ttb_sim.report.metrics import (bag_metrics, CAR_BODY_LOWEST_HZ, marks_of, observer_stations,
+                                    power_flows, soil_line, soil_val_points)
+from ttb_sim.report.output import FigureNote
 
 log = logging.getLogger(__name__)
 

@@ -13,18 +13,20 @@
 # limitations under the License.
 
 """
-Output folders of ``analyze`` and ``compare``: staged writing and the ``index.html`` page.
+Output folders of ``analyze`` and ``compare``: staged writing, JSON and the ``index.html`` page.
 
 :func:`staged_output` gives a hidden sibling folder to write into and renames it
 to the destination only when everything is written, so an interrupted or
 failed analysis never leaves a folder that looks complete.  A destination that
 holds an earlier analysis (its ``metrics.json``) is replaced; any other
-non-empty folder is refused.
+non-empty folder is refused.  :func:`write_json` (NaN and infinities as null) also
+writes the files of ``sweep``; :class:`FigureNote` is what the page lists of a figure.
 """
 
 from __future__ import annotations
 
 from contextlib import contextmanager
+from dataclasses import dataclass
 import html
 import json
 import math
@@ -33,8 +35,15 @@ from pathlib import Path
 import shutil
 from typing import Any, Iterator, Sequence
 
-from ttb_sim.commands.report import FigureNote
 from ttb_sim.errors import ScenarioError
+
+
+@dataclass(frozen=True)
+class FigureNote:
+    """A figure written (file, caption) or skipped (file, reason)."""
+
+    name: str
+    text: str
 
 
 def check_output(out: Path) -> None:

@@ -13,22 +13,22 @@
 # limitations under the License.
 
 """
-Metrics and figures of bags, shared by ``ttb-sim analyze`` (one bag) and ``compare`` (several).
+Metrics of bags, shared by ``ttb-sim analyze`` (one bag), ``compare`` (several) and ``sweep``.
 
-:func:`bag_metrics` computes the numbers of one :class:`Streams` (written to
-``metrics.json``); :func:`write_figures` draws every figure the bags have the
-streams for, each bag a trace, and returns what it wrote and what it skipped
-with the reason.  The physics lives in :mod:`ttb_sim.analysis`; this module
-only picks the streams and lays them out.
+:func:`bag_metrics` computes the numbers of one :class:`~ttb_sim.io.streams.Streams`
+(written to ``metrics.json``); the stream pickers beside it (excitation marks, the
+soil observation line and VAL points, the observer stations and their power flow)
+are shared with :mod:`ttb_sim.report.figures`; :func:`flatten` and
+:func:`differences` give the table of ``compare``.  The physics lives in
+:mod:`ttb_sim.analysis`; this module only picks the streams and lays them out.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
 import logging
 import math
 import re
-from typing import Any
+from typing import Any, Sequence
 
 import numpy as np
 
@@ -41,7 +41,7 @@ from ttb_sim.analysis.ride import CAR_BODY_LIMITS, sperling_grade, sperling_inde
 from ttb_sim.analysis.safety import (deck_acceleration, derailment_coefficient,
                                      lateral_force_limit, LIMITS, wheel_load_reduction)
 from ttb_sim.analysis.weighting import weighted_rms
-from ttb_sim.commands.streams import Series, Streams
+from ttb_sim.io.streams import Series, Streams
 
 log = logging.getLogger(__name__)
 
@@ -51,14 +51,6 @@ SPERLING_LIMIT = 2.5
 """Sperling index below which a passenger car rates 'excellent'."""
 _OBSERVER = re.compile(r'^\s*([^=\s]+)\s*=\s*(\w+)\s*@\s*([-+0-9.eE]+)\s*$')
 _LAYERS = ('rail', 'slab', 'base', 'girder')
-
-
-@dataclass(frozen=True)
-class FigureNote:
-    """A figure written (file, caption) or skipped (file, reason)."""
-
-    name: str
-    text: str
 
 
 # -- excitation marks ---------------------------------------------------------------------
@@ -367,3 +359,44 @@ def power_flows(s: Streams) -> dict[str, dict[str, tuple[np.ndarray, np.ndarray]
             'base': power_flow_spectrum(q_ca, v['base'], fs),
             'girder': power_flow_spectrum(q_bg, v['girder'], fs)}
     return out
+
+
+# -- comparing bags ----------------------------------------------------------------------
+
+def flatten(metrics: dict[str, Any], prefix: str = '') -> dict[str, float]:
+    """Return the numeric leaves of a metrics tree as {'a.b.c': value} (lists left out)."""
+    out: dict[str, float] = {}
+    for key, value in metrics.items():
+        name = f'{prefix}{key}'
+        if isinstance(value, dict):
+            out.update(flatten(value, name + '.'))
+        elif isinstance(value, (int, float)) and not isinstance(value, bool):
+            out[name] = float(value)
+    return out
+
+
+def differences(labels: Sequence[str], metrics: Sequence[dict[str, Any]]) -> list[list[Any]]:
+    """
+    Return rows (metric, value per bag, then per other bag: difference and relative difference).
+
+    Differences are against the first bag; the relative one is None where the
+    first bag's value is 0. Bookkeeping numbers (durations, rates, times) are left out.
+    """
+    flat = [flatten({k: v for k, v in m.items()
+                     if k not in ('analysis_time_s', 'duration_s', 'sample_rate_hz',
+                                  'excitation_hz')}) for m in metrics]
+    keys: list[str] = []
+    for f in flat:
+        keys.extend(k for k in f if k not in keys and not k.endswith('.limit'))
+    rows = []
+    for key in keys:
+        values = [f.get(key) for f in flat]
+        row: list[Any] = [key, *values]
+        base = values[0]
+        for v in values[1:]:
+            if base is None or v is None:
+                row.extend([None, None])
+            else:
+                row.extend([v - base, (v - base) / abs(base) if base else None])
+        rows.append(row)
+    return rows

@@ -1,0 +1,224 @@
+# Copyright 2026 The ttb_sim Authors
+#
+# Licensed under the Apache License, Version 2.0 (the "License");
+# you may not use this file except in compliance with the License.
+# You may obtain a copy of the License at
+#
+#     http://www.apache.org/licenses/LICENSE-2.0
+#
+# Unless required by applicable law or agreed to in writing, software
+# distributed under the License is distributed on an "AS IS" BASIS,
+# WITHOUT WARRANTIES OR CONDITIONS OF ANY KIND, either express or implied.
+# See the License for the specific language governing permissions and
+# limitations under the License.
+
+"""
+The ROS-free half of the rclpy shell (:mod:`ttb_sim.simulator_node`).
+
+What the shell decides without ROS lives here, so that it is tested where ROS 2 is
+absent: the order of the start-up parameters (the scenario first, then its own),
+the filter that lets a repeating model warning through once, the bag destination
+and the opening of the recorder, the guard that keeps ``/clock`` from going
+backwards, the node's ``/diagnostics`` report (the passage's, or the build's while
+the model is being built, with the publishing counters), the answer of the pause
+service, and the messages the shell logs for passage events and answers while
+building.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+import logging
+from pathlib import Path
+import threading
+from typing import Any, Callable, Mapping
+
+from ttb_sim.config import load_scenario, Scenario
+from ttb_sim.io.bag import BagRecorder, check_destination, default_bag_path, make_parents
+from ttb_sim.io.topics import Topic, topic_table
+from ttb_sim.node.diagnostics import DiagnosticsReport, ERROR, OK
+from ttb_sim.node.parameters import (DEFAULT_SCENARIO, initial_values, NodeParameter,
+                                     parameter_table)
+from ttb_sim.node.passage import FrameSink, PassageController, Tick
+from ttb_sim.node.publishing import PublishStats
+from ttb_sim.node.stepper import StepperStatus
+from ttb_sim.sim import Layout, Simulation
+
+
+@dataclass(frozen=True)
+class StartUp:
+    """The node's start-up: the scenario, its parameter table, the values given and in force."""
+
+    scenario: Scenario
+    table: dict[str, NodeParameter]
+    given: dict[str, Any]
+    values: dict[str, Any]
+
+    def integers_for_doubles(self) -> list[str]:
+        """Return the double parameters given as integers (to be stored as doubles, too)."""
+        return [n for n, p in self.table.items()
+                if p.kind == 'double' and not isinstance(self.given[n], float)]
+
+
+def declare_parameters(declare: Callable[[str, Any, NodeParameter], Any]) -> StartUp:
+    """
+    Declare the ``scenario`` parameter, load the scenario, then declare its parameters.
+
+    ``declare(name, default, parameter)`` declares one parameter and returns its
+    start-up value (the ROS node's ``declare_parameter``).
+
+    Raises
+    ------
+    ScenarioError
+        For a scenario that does not load, or a start-up value ``declare`` refuses.
+
+    """
+    source = declare('scenario', DEFAULT_SCENARIO, parameter_table()['scenario'])
+    scenario = load_scenario(source)
+    table = parameter_table(scenario)
+    given: dict[str, Any] = {'scenario': source}
+    for name, param in table.items():
+        if name != 'scenario':
+            given[name] = declare(name, param.default, param)
+    return StartUp(scenario, table, given, initial_values(table, given))
+
+
+class OnceFilter(logging.Filter):
+    """Let each distinct log message through once (a model warning, not once per passage)."""
+
+    def __init__(self) -> None:
+        super().__init__()
+        self._seen: set[str] = set()
+
+    def filter(self, record: logging.LogRecord) -> bool:  # noqa: A003 - logging API
+        """Return True the first time a message is seen."""
+        message = record.getMessage()
+        if message in self._seen:
+            return False
+        self._seen.add(message)
+        return True
+
+
+ONCE_LOGGERS = (Simulation.__module__,)
+"""Loggers of the model whose warnings repeat with every passage (each builds the model)."""
+
+
+def quiet_repeated_warnings() -> None:
+    """Give every logger of :data:`ONCE_LOGGERS` one :class:`OnceFilter` (idempotent)."""
+    for name in ONCE_LOGGERS:
+        logger = logging.getLogger(name)
+        if not any(isinstance(f, OnceFilter) for f in logger.filters):
+            logger.addFilter(OnceFilter())
+
+
+def bag_destination(values: Mapping[str, Any], scenario_name: str) -> Path | None:
+    """
+    Return the bag directory of the node's parameters (None when ``bag.enabled`` is false).
+
+    Raises
+    ------
+    ScenarioError
+        When the destination cannot be created (named as ``bag.path``).
+
+    """
+    if not values['bag.enabled']:
+        return None
+    path = Path(values['bag.path']) if values['bag.path'] else default_bag_path(scenario_name)
+    check_destination(path, values['bag.storage'], option='bag.path')
+    return path
+
+
+def open_bag(path: Path, storage: str, layout: Layout, namespace: str) -> FrameSink:
+    """Open the node's bag of the model's topic table under the node's namespace."""
+    make_parents(path)
+    return BagRecorder(path, topic_table(layout), storage, namespace=namespace).__enter__()
+
+
+class ClockGuard:
+    """Send ``/clock`` stamps that never go backwards, from any thread."""
+
+    def __init__(self) -> None:
+        self._lock = threading.Lock()
+        self._last = -1
+
+    def send(self, stamp_ns: int, publish: Callable[[int, int], None]) -> None:
+        """Call ``publish(sec, nanosec)`` unless the stamp is older than the last one sent."""
+        with self._lock:   # held while publishing: two threads cannot swap their stamps
+            if stamp_ns < self._last:
+                return
+            self._last = stamp_ns
+            sec, nanosec = divmod(int(stamp_ns), 1_000_000_000)
+            publish(sec, nanosec)
+
+
+def live_topics(topics: list[Topic]) -> list[tuple[Topic, str]]:
+    """Return the topics published live (all but /clock) with their node-relative names."""
+    return [(t, t.name if t.name.startswith('/') else f'~/{t.name}') for t in topics
+            if t.qos != 'clock']
+
+
+def building_message(status: StepperStatus) -> str:
+    """Return the answer of a service called before the model exists."""
+    if status.state == 'failed':
+        return f'the model could not be built: {status.error}'
+    return f'the model is still being built ({status.elapsed:.1f} s so far); try again'
+
+
+def pause_answer(controller: PassageController, paused: bool) -> tuple[bool, str]:
+    """Pause or resume; return (success, message) of the ``~/pause`` service."""
+    message = controller.set_paused(paused)
+    return controller.state in ('paused', 'running'), message
+
+
+def tick_messages(tick: Tick, controller: PassageController | None) -> list[tuple[str, str]]:
+    """Return the (level, message) lines to log for a tick's passage events."""
+    out = []
+    if 'diverged' in tick.events and controller is not None:
+        out.append(('error', f'{controller.divergence}; stepping stopped, bag closed; '
+                    'call ~/reset to restart'))
+    if 'idle' in tick.events:
+        out.append(('info', 'the train has left: idle (set loop:=true or call ~/reset for '
+                    'another passage)'))
+    return out
+
+
+def node_diagnostics(scenario_name: str, status: StepperStatus,
+                     passage: DiagnosticsReport | None, publishing: PublishStats | None = None,
+                     publish_error: str = '') -> DiagnosticsReport:
+    """
+    Return the node's ``/diagnostics`` report.
+
+    Parameters
+    ----------
+    scenario_name : str
+        The scenario's name.
+    status : StepperStatus
+        What the stepping thread is doing.
+    passage : DiagnosticsReport or None
+        The passage controller's report, once the model is built (None before).
+    publishing : PublishStats, optional
+        The publishing counters, once publishing has started.
+    publish_error : str
+        Why publishing stopped ('' if it did not).
+
+    """
+    if passage is None:
+        if status.state == 'failed':
+            level, message = ERROR, f'cannot build the model: {status.error}'
+        else:
+            level, message = OK, f'building model: {status.elapsed:.1f} s'
+        values = [('state', status.state), ('scenario', scenario_name),
+                  ('build time so far (s)', f'{status.elapsed:.1f}')]
+        return DiagnosticsReport(level, message, tuple(values))
+    level, message = passage.level, passage.message
+    values = list(passage.values)
+    values.append(('model build time (s)', f'{status.elapsed:.2f}'))
+    if status.state == 'failed':
+        level, message = ERROR, status.error
+    if publishing is not None:
+        values += [('published frames', str(publishing.published)),
+                   ('dropped frames (publishing could not keep up)', str(publishing.dropped)),
+                   ('publish CPU time per frame (ms)', f'{publishing.ms_per_frame:.3f}')]
+        if publish_error:
+            level, message = ERROR, publish_error
+    return DiagnosticsReport(level, message, tuple(values))
