@@ -33,6 +33,7 @@ from typing import Literal
 import numpy as np
 import scipy.sparse as sp
 
+from ttb_sim.errors import FEError
 from ttb_sim.fe.assembly import assemble
 from ttb_sim.fe.quad import face_frames, FACE_N
 
@@ -89,7 +90,7 @@ def face_matrices(coords: np.ndarray, normal_value: np.ndarray,
             out[:, 3 * a:3 * a + 3, 3 * a:3 * a + 3] = nodal[:, a]
         return out
     if lumping != 'consistent':
-        raise ValueError(f"lumping must be 'lumped' or 'consistent', not {lumping!r}")
+        raise FEError(f"lumping must be 'lumped' or 'consistent', not {lumping!r}")
     nn = np.einsum('ga,gb,eg,egij->eaibj', FACE_N, FACE_N, weights, block)
     return nn.reshape(len(coords), 12, 12)
 

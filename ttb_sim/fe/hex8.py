@@ -35,6 +35,8 @@ from typing import Callable
 import numpy as np
 import scipy.sparse as sp
 
+from ttb_sim.errors import FEError
+
 _G = 1.0 / np.sqrt(3.0)
 #: Natural coordinates of the node corners.
 CORNERS = np.array([[-1, -1, -1], [1, -1, -1], [1, 1, -1], [-1, 1, -1],
@@ -84,8 +86,8 @@ def _jacobians(coords: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     jac = np.einsum('gai,eaj->egij', _DN, coords)
     det = np.linalg.det(jac)
     if np.any(det <= 0):
-        raise ValueError('hexahedron with a non-positive Jacobian (inverted or '
-                         'badly ordered nodes)')
+        raise FEError('hexahedron with a non-positive Jacobian (inverted or '
+                      'badly ordered nodes)')
     grad = np.einsum('egij,gaj->egai', np.linalg.inv(jac), _DN)
     return grad, det
 

@@ -34,6 +34,8 @@ from typing import Sequence
 
 import numpy as np
 
+from ttb_sim.errors import FEError
+
 #: Local node ids of the six faces of a hexahedron, outward oriented:
 #: -x, +x, -y, +y, -z, +z.
 HEX_FACES = np.array([[0, 4, 7, 3], [1, 2, 6, 5], [0, 1, 5, 4],
@@ -162,7 +164,7 @@ class Grid:
 
         Raises
         ------
-        ValueError
+        FEError
             If a point lies outside the grid.
 
         """
@@ -175,7 +177,7 @@ class Grid:
             if np.any(p < planes[0] - tol) or np.any(p > planes[-1] + tol):
                 message = (f'points {points.tolist()} lie outside the grid '
                            f'[{planes[0]:g}, {planes[-1]:g}] along axis {"xyz"[axis]}')
-                raise ValueError(message)
+                raise FEError(message)
             i = np.clip(np.searchsorted(planes, p, side='right') - 1, 0, len(planes) - 2)
             index.append(i)
             local.append(2.0 * (p - planes[i]) / (planes[i + 1] - planes[i]) - 1.0)

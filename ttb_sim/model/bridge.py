@@ -37,13 +37,13 @@ from typing import Mapping
 import numpy as np
 import scipy.sparse as sp
 
+from ttb_sim.declarations import check_declared, param
 from ttb_sim.errors import ModelError
 from ttb_sim.fe.assembly import assemble, assemble_links, link_kinematics
 from ttb_sim.fe.beam import BeamSection, global_matrices, NODE_DOFS, vertical_row, W_DOFS
 from ttb_sim.fe.dofs import DofMap
 from ttb_sim.model.foundation.operator import FoundationOperator
 from ttb_sim.model.track import BeamLine, build_track, TrackMesh, TrackParameters
-from ttb_sim.parameters import check_declared, param
 
 
 @dataclass(frozen=True)

@@ -40,9 +40,9 @@ import math
 
 import numpy as np
 
+from ttb_sim.declarations import check_declared, param
 from ttb_sim.fe.assembly import link_kinematics
 from ttb_sim.fe.beam import BeamSection, field_rows, NODE_DOFS, offset_rows, point_rows
-from ttb_sim.parameters import check_declared, param
 
 
 @dataclass(frozen=True)

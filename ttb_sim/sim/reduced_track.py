@@ -64,7 +64,7 @@ from ttb_sim.fe.factorization import factorize
 from ttb_sim.model.bridge import Structure
 from ttb_sim.model.irregularity import TrackIrregularity
 from ttb_sim.model.vehicle.car import CarParameters
-from ttb_sim.model.wheel_rail.parameters import ContactParameters
+from ttb_sim.model.wheel_rail.contact_parameters import ContactParameters
 from ttb_sim.sim.coupling.train_track import RailCompliance, TrainTrackCoupling
 from ttb_sim.sim.integrators.newmark import Newmark
 from ttb_sim.sim.integrators.protocol import Integrator

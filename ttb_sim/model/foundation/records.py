@@ -16,7 +16,7 @@
 Records describing a pier-cap-pile-soil substructure and its load (SI units).
 
 Frozen dataclasses whose user-settable fields are declared once with
-:func:`~ttb_sim.parameters.param` (default, unit, range, description): the
+:func:`~ttb_sim.declarations.param` (default, unit, range, description): the
 scenario sections ``soil``, ``piles``, ``cap``, ``interface`` and ``load`` are
 these records, so every field is a scenario key. A bad value raises
 :class:`FoundationError` naming the key, the value and what is allowed.
@@ -37,9 +37,9 @@ from dataclasses import dataclass, field
 import math
 from typing import Optional
 
+from ttb_sim.declarations import check_declared, param
 from ttb_sim.errors import ModelError
 from ttb_sim.model.constants import GRAVITY
-from ttb_sim.parameters import check_declared, param
 
 #: Side of the square of equal area over the diameter of a circle, sqrt(pi) / 2.
 EQUAL_AREA_SIDE = math.sqrt(math.pi) / 2.0

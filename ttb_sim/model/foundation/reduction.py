@@ -248,8 +248,8 @@ def pile_soil_operator(spec: Substructure, pier_height: float, pier_elements: in
     """
     check_spec(spec)
     if len(pier_section.ea) != pier_elements:
-        raise ValueError(f'pier_section has {len(pier_section.ea)} elements, pier_elements '
-                         f'= {pier_elements}')
+        raise FoundationError(f'pier_section has {len(pier_section.ea)} elements, pier_elements '
+                              f'= {pier_elements}')
     key = cache_key(spec, pier_height, pier_elements, pier_section, pier_rayleigh, reduction)
     path = cache_directory() / f'pile_soil_{key[:32]}.npz' if cache else None
     if path is not None and path.exists():
@@ -502,16 +502,16 @@ def interface_mobilisation(op: FoundationOperator, q_history: np.ndarray) -> flo
 
     Raises
     ------
-    ValueError
+    FoundationError
         When ``op`` has no interface rows or q has the wrong size.
 
     """
     rows = op.interface
     if rows is None:
-        raise ValueError('this foundation operator has no interface rows')
+        raise FoundationError('this foundation operator has no interface rows')
     q = np.atleast_2d(np.asarray(q_history, dtype=float))
     if q.shape[1] != op.size:
-        raise ValueError(f'q_history has {q.shape[1]} coordinates, the operator {op.size}')
+        raise FoundationError(f'q_history has {q.shape[1]} coordinates, the operator {op.size}')
     worst = 0.0
     for start in range(0, len(q), 1024):
         chunk = q[start:start + 1024]
@@ -628,7 +628,7 @@ def _load(path: Path) -> Optional[FoundationOperator]:
         if 'interface_normal' in got:
             iface = InterfaceRows(**{name: got[f'interface_{name}'] for name in _INTERFACE})
             if iface.normal.shape[1] != n or iface.shear.shape != (2 * iface.n_points, n):
-                raise ValueError('interface rows of the wrong shape')
+                raise FoundationError('interface rows of the wrong shape')
         op = FoundationOperator(**{name: got[name] for name in _ARRAYS},
                                 soil_point_names=tuple(str(s) for s in got['soil_point_names']),
                                 depth=float(got['depth']),
@@ -636,7 +636,7 @@ def _load(path: Path) -> Optional[FoundationOperator]:
         square = all(getattr(op, a).shape == (n, n) for a in ('mass', 'damping', 'stiffness'))
         if (not square or op.pile_heads.shape != (3 * op.n_piles, n)
                 or op.soil_points.shape != (3 * len(op.soil_point_names), n)):
-            raise ValueError('arrays of inconsistent shapes')
+            raise FoundationError('arrays of inconsistent shapes')
         return op
     except Exception as err:  # noqa: B902 - any unreadable cache file means: rebuild
         LOG.warning('the cache file %s is unreadable (%s); rebuilding', path,

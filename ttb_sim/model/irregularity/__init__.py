@@ -21,9 +21,11 @@ Track irregularity: the public face of the modules of this package.
   and its sampling with derivatives.
 - :mod:`.synthesis`: random profiles from spectra, layers and presets.
 - :mod:`.measured`: measured profiles from CSV, and CSV output.
-- :mod:`.variance`: the V8/V10 variance check of the synthesis.
+- :data:`GRID_SLACK`: the tolerance, in grid steps, for positions and lengths on a
+  profile's grid (shared with the couplings that sample profiles).
 """
 
+from ttb_sim.model.irregularity._checks import GRID_SLACK
 from ttb_sim.model.irregularity.measured import CSV_COLUMNS, load_csv, MIN_CSV_ROWS, save_csv
 from ttb_sim.model.irregularity.profile import (IrregularitySample, RAIL_QUANTITIES,
                                                 TrackIrregularity)
@@ -38,6 +40,7 @@ __all__ = [
     'COMPONENTS',
     'CONTACT_SPACING',
     'CSV_COLUMNS',
+    'GRID_SLACK',
     'IrregularityLayer',
     'IrregularitySample',
     'MIN_CSV_ROWS',

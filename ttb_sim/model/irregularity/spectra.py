@@ -132,7 +132,7 @@ class SpectrumComponent:
             message = (
                 f'{self.family}.{self.name}: need 0 < wavelength_min < wavelength_max, '
                 f'got {self.wavelength_min} and {self.wavelength_max} m')
-            raise ValueError(message)
+            raise ModelError(message)
 
     @property
     def label(self) -> str:
@@ -155,13 +155,13 @@ class SpectrumComponent:
 
         Raises
         ------
-        ValueError
+        ModelError
             If any frequency is not a positive finite number.
 
         """
         freq = np.asarray(n, dtype=float)
         if not np.all(np.isfinite(freq) & (freq > 0.0)):
-            raise ValueError(f'{self.label}: spatial frequencies must be finite and > 0')
+            raise ModelError(f'{self.label}: spatial frequencies must be finite and > 0')
         return self.density(freq)
 
     def band(
@@ -306,7 +306,7 @@ class SpectrumFamily:
     def __post_init__(self) -> None:
         unknown = set(self.components) - set(COMPONENTS)
         if unknown:
-            raise ValueError(f'{self.name}: unknown components {sorted(unknown)}')
+            raise ModelError(f'{self.name}: unknown components {sorted(unknown)}')
         ordered = {c: self.components[c] for c in COMPONENTS if c in self.components}
         object.__setattr__(self, 'components', MappingProxyType(ordered))
 

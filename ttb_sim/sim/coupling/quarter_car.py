@@ -42,8 +42,7 @@ import numpy as np
 
 from ttb_sim.model.bridge import GirderLine, Structure
 from ttb_sim.model.constants import GRAVITY
-from ttb_sim.model.irregularity import TrackIrregularity
-from ttb_sim.model.irregularity._checks import GRID_SLACK
+from ttb_sim.model.irregularity import GRID_SLACK, TrackIrregularity
 from ttb_sim.model.vehicle.train import QuarterCars
 from ttb_sim.sim import quarter_car_kernels
 from ttb_sim.sim.coupling.base import FreeDofState, girder_wheel_load, VehicleOutputs

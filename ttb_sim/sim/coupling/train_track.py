@@ -77,14 +77,13 @@ from ttb_sim.errors import DivergenceError, ModelError
 from ttb_sim.fe.beam import interior_compliance
 from ttb_sim.fe.factorization import factorize
 from ttb_sim.model.bridge import Structure
-from ttb_sim.model.irregularity import TrackIrregularity
-from ttb_sim.model.irregularity._checks import GRID_SLACK
+from ttb_sim.model.irregularity import GRID_SLACK, TrackIrregularity
 from ttb_sim.model.track import BeamLine
 from ttb_sim.model.vehicle.car import CarParameters
 from ttb_sim.model.vehicle.dofs import dofs as car_dofs
 from ttb_sim.model.vehicle.matrices import gyroscopic_matrix, train_matrices
 import ttb_sim.model.wheel_rail as ct
-from ttb_sim.model.wheel_rail.parameters import ContactParameters
+from ttb_sim.model.wheel_rail.contact_parameters import ContactParameters
 from ttb_sim.model.wheel_rail.profiles import contact_geometry_table, ContactGeometryTable
 from ttb_sim.sim import kernels
 from ttb_sim.sim.coupling.base import FreeDofState, VehicleOutputs
