@@ -19,7 +19,8 @@ A scenario is a tree of these records (:class:`Scenario` at the root).  Every
 leaf is declared with :func:`~ttb_sim.declarations.param` (default, unit, range
 or choices, description). The sections the model consumes are the model's own
 records: car (:class:`~ttb_sim.model.vehicle.car.CarParameters`), track, bridge,
-bearings, piers, foundation (``model/track.py``, ``model/bridge.py``), contact
+piers, bearings, foundation (``model/track.py``, ``model/bridge.py``,
+``model/bearings.py``, ``model/foundation/pier_foundations.py``), contact
 (``model/wheel_rail/contact_parameters.py``) and the pile-soil sections soil, piles, cap,
 interface and load (``model/foundation/records.py``); the rest (train, irregularity, solver,
 output) are declared here.  Rules that involve more
@@ -39,8 +40,9 @@ from ttb_sim.config.schema import to_plain
 from ttb_sim.declarations import param
 from ttb_sim.errors import ScenarioError
 from ttb_sim.inputs import shown
-from ttb_sim.model.bridge import (BearingParameters, BridgeParameters, FoundationParameters,
-                                  PierParameters, span_frequency)
+from ttb_sim.model.bearings import BearingParameters
+from ttb_sim.model.bridge import BridgeParameters, PierParameters, span_frequency
+from ttb_sim.model.foundation.pier_foundations import FoundationParameters
 from ttb_sim.model.foundation.records import (Cap, check_substructure, Interface, Observation,
                                               PileGroup, PileLoad, SoilParameters, Substructure)
 from ttb_sim.model.foundation.substructure import planned_nodes

@@ -52,7 +52,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from ttb_sim.fe import hex8
-from ttb_sim.fe.assembly import assemble
+from ttb_sim.fe.assembly import assemble, assemble_chunked
 from ttb_sim.fe.boundary import face_matrices, viscoelastic_coefficients
 from ttb_sim.fe.interface import interface_set, InterfaceSet
 from ttb_sim.fe.mesh import graded_planes, Grid, HEX_FACES, Mesh, node_dofs
@@ -388,7 +388,7 @@ def build(spec: Substructure, load: Optional[PileLoad] = None) -> PileSoilModel:
             k = hex8.stiffness(coords[e], young[material[e]], poisson[material[e]])
             return k * (1.0 + 1j * beta[material[e]])[:, None, None]
 
-        both = hex8.assemble_chunked(n_dofs, dofs[sel], kernel, dtype=complex)
+        both = assemble_chunked(n_dofs, dofs[sel], kernel, dtype=complex)
         stiff = sp.csr_matrix((both.data.real.copy(), both.indices, both.indptr),
                               shape=both.shape)
         m_alpha = np.bincount(dofs[sel].ravel(),
