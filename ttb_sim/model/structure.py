@@ -227,6 +227,20 @@ def _girder_ends(beams: _Beams) -> tuple[np.ndarray, np.ndarray]:
     return ends, end_support
 
 
+def _bearings(br: BearingParameters, beams: _Beams, blocks: PiledBlocks, moving: np.ndarray
+              ) -> tuple[RigidEnds | None, BearingLinks | None]:
+    """
+    Return the rigid girder ends or the elastic bearings (the other None).
+
+    ``moving`` marks the supports whose pier top is not a node of the structure
+    (partitioned piled piers).
+    """
+    ends, end_support = _girder_ends(beams)
+    if br.model == 'rigid':
+        return rigid_ends(ends, end_support), None
+    return None, bearing_links(br, ends, end_support, blocks.pier_top, moving)
+
+
 def _dof_map(beams: _Beams, blocks: PiledBlocks, constrained: np.ndarray) -> DofMap:
     """Return the numbering: blocks girders, piers, track, substructures; interfaces."""
     ends, _ = _girder_ends(beams)
@@ -303,16 +317,12 @@ def assemble_structure(b: BridgeParameters, br: BearingParameters, pr: PierParam
     # Interfaces: bearings between girder ends and supports, foundations under piers.
     constrained = np.zeros(n_full, dtype=bool)
     constrained[blocks.padding] = True
-    ends, end_support = _girder_ends(beams)
-    ends_rigid: RigidEnds | None = None
-    links_elastic: BearingLinks | None = None
-    if br.model == 'rigid':
-        ends_rigid = rigid_ends(ends, end_support)
+    moving = np.zeros(b.n_spans + 1, dtype=bool)
+    moving[list(piled)] = not monolithic
+    ends_rigid, links_elastic = _bearings(br, beams, blocks, moving)
+    if ends_rigid is not None:
         constrained[ends_rigid.full_dofs] = True
-    else:
-        moving = np.zeros(b.n_spans + 1, dtype=bool)
-        moving[list(piled)] = not monolithic
-        links_elastic = bearing_links(br, ends, end_support, blocks.pier_top, moving)
+    if links_elastic is not None:
         k_link, c_link = links_elastic.matrices(n_full)
         k_full, c_full = k_full + k_link, c_full + c_link
     bases = beams.pier_base[beams.pier_base >= 0]
