@@ -45,7 +45,7 @@ from ttb_sim.model.bridge import BridgeParameters, PierParameters, span_frequenc
 from ttb_sim.model.foundation.pier_foundations import FoundationParameters
 from ttb_sim.model.foundation.records import (Cap, check_substructure, Interface, Observation,
                                               PileGroup, PileLoad, SoilParameters, Substructure)
-from ttb_sim.model.foundation.substructure import planned_nodes
+from ttb_sim.model.foundation.soil_mesh import planned_nodes
 from ttb_sim.model.track import track_extent, TrackExtent, TrackParameters
 from ttb_sim.model.vehicle.car import CarParameters
 from ttb_sim.model.wheel_rail.contact_parameters import ContactParameters

@@ -83,7 +83,8 @@ from ttb_sim.model.foundation.operator import (FoundationOperator, InterfaceRows
                                                pier_column)
 from ttb_sim.model.foundation.records import (FoundationError, ReductionParameters,
                                               Substructure)
-from ttb_sim.model.foundation.substructure import build, CAP, PileSoilModel, planned_nodes
+from ttb_sim.model.foundation.soil_mesh import CAP, planned_nodes
+from ttb_sim.model.foundation.substructure import build, PileSoilModel
 
 LOG = logging.getLogger(__name__)
 
