@@ -42,9 +42,10 @@ from ttb_sim.errors import ScenarioError
 from ttb_sim.inputs import shown
 from ttb_sim.model.bearings import BearingParameters
 from ttb_sim.model.bridge import BridgeParameters, PierParameters, span_frequency
+from ttb_sim.model.foundation.consistency import check_substructure
 from ttb_sim.model.foundation.pier_foundations import FoundationParameters
-from ttb_sim.model.foundation.records import (Cap, check_substructure, Interface, Observation,
-                                              PileGroup, PileLoad, SoilParameters, Substructure)
+from ttb_sim.model.foundation.records import (Cap, Interface, Observation, PileGroup, PileLoad,
+                                              SoilParameters, Substructure)
 from ttb_sim.model.foundation.soil_mesh import planned_nodes
 from ttb_sim.model.track import track_extent, TrackExtent, TrackParameters
 from ttb_sim.model.vehicle.car import CarParameters

@@ -16,7 +16,9 @@
 The piers' foundations: springs or piled, and the 3-D pile-soil substructure of a piled pier.
 
 :mod:`.pier_foundations` (the foundation record, springs, piled piers in the structure),
-:mod:`.records` (soil, piles, cap, interface, load), :mod:`.desai` (the interface law),
-:mod:`.soil_mesh`, :mod:`.substructure` and :mod:`.observation` (the finite-element
-substructure), :mod:`.operator` and :mod:`.reduction` (its reduced operator).
+:mod:`.records` and :mod:`.consistency` (soil, piles, cap, interface, load, and their
+cross-checks), :mod:`.desai` (the interface law), :mod:`.soil_mesh`, :mod:`.substructure`
+and :mod:`.observation` (the finite-element substructure), :mod:`.operator` (what the
+bridge sees of it), :mod:`.tied`, :mod:`.krylov`, :mod:`.reduction` and
+:mod:`.operator_cache` (its reduced operator and the cache of it).
 """

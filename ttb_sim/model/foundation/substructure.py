@@ -58,10 +58,11 @@ from ttb_sim.fe.interface import interface_set, InterfaceSet
 from ttb_sim.fe.mesh import FACE_NAMES, Grid, grid_cells, GridCells, HEX_FACES, Mesh, node_dofs
 from ttb_sim.fe.quad import FACE_N
 from ttb_sim.model.constants import GRAVITY
+from ttb_sim.model.foundation.consistency import check_substructure
 from ttb_sim.model.foundation.desai import DesaiLaw, initial_moduli
 from ttb_sim.model.foundation.observation import (head_operators, soil_points, SoilPoints,
                                                   surface_weights)
-from ttb_sim.model.foundation.records import check_substructure, PileLoad, Substructure
+from ttb_sim.model.foundation.records import PileLoad, Substructure
 from ttb_sim.model.foundation.soil_mesh import (CAP, CellTags, check_aspect, InterfaceSplit,
                                                 PILE, SOIL, soil_grid, split_interface,
                                                 tag_cells)
@@ -204,7 +205,7 @@ def build(spec: Substructure, load: Optional[PileLoad] = None) -> PileSoilModel:
     Raises
     ------
     FoundationError
-        On inconsistent records (see :func:`~.records.check_substructure`) or a
+        On inconsistent records (see :func:`~.consistency.check_substructure`) or a
         mesh whose aspect ratio exceeds ``mesh.max_aspect``.
 
     """
