@@ -39,6 +39,7 @@ import scipy.sparse as sp
 from ttb_sim.fe.assembly import assemble, assemble_links
 from ttb_sim.fe.beam import BeamSection, global_matrices, NODE_DOFS
 from ttb_sim.fe.dofs import DofMap
+from ttb_sim.model.beam_line import BeamLine
 from ttb_sim.model.bearings import (bearing_links, BearingLinks, BearingParameters, Bearings,
                                     rigid_ends, RigidEnds, RigidSupports)
 from ttb_sim.model.bridge import (BeamBlock, BridgeParameters, girder_block, girder_line,
@@ -49,7 +50,7 @@ from ttb_sim.model.foundation.operator import FoundationOperator
 from ttb_sim.model.foundation.pier_foundations import (add_piled_blocks, foundation_springs,
                                                        FoundationParameters, piled_blocks,
                                                        PiledBlocks)
-from ttb_sim.model.track import BeamLine, build_track, TrackMesh, TrackParameters
+from ttb_sim.model.track import build_track, TrackMesh, TrackParameters
 
 
 @dataclass(frozen=True)

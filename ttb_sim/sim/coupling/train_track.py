@@ -76,9 +76,9 @@ import scipy.sparse as sp
 from ttb_sim.errors import DivergenceError, ModelError
 from ttb_sim.fe.beam import interior_compliance
 from ttb_sim.fe.factorization import factorize
+from ttb_sim.model.beam_line import BeamLine
 from ttb_sim.model.irregularity import GRID_SLACK, TrackIrregularity
 from ttb_sim.model.structure import Structure
-from ttb_sim.model.track import BeamLine
 from ttb_sim.model.vehicle.car import CarParameters
 from ttb_sim.model.vehicle.dofs import dofs as car_dofs
 from ttb_sim.model.vehicle.matrices import gyroscopic_matrix, train_matrices
