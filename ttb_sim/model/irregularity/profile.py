@@ -57,7 +57,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from ttb_sim.errors import ModelError
 from ttb_sim.model.irregularity._checks import GRID_SLACK
-from ttb_sim.model.irregularity.spectra import COMPONENTS
+from ttb_sim.model.irregularity.spectrum_records import COMPONENTS
 
 __all__ = [
     'IrregularitySample',
