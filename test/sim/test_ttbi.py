@@ -23,7 +23,7 @@ from ttb_sim.config import load_scenario
 from ttb_sim.errors import ScenarioError
 from ttb_sim.model.vehicle.dofs import dof
 import ttb_sim.model.wheel_rail as ct
-from ttb_sim.model.wheel_rail.profiles import contact_geometry_table
+from ttb_sim.model.wheel_rail.contact_table import contact_geometry_table
 from ttb_sim.sim.simulation import Simulation
 
 SMALL = [('train.vehicle', 'car'), ('track.model', 'slab'), ('train.n_cars', 1),

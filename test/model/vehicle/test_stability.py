@@ -37,7 +37,7 @@ from ttb_sim.model.vehicle.car import CarParameters
 from ttb_sim.model.vehicle.dofs import N_DOF, wheelset_dofs
 from ttb_sim.model.vehicle.matrices import contact_map
 import ttb_sim.model.wheel_rail as ct
-from ttb_sim.model.wheel_rail.profiles import contact_geometry_table
+from ttb_sim.model.wheel_rail.contact_table import contact_geometry_table
 
 KMH = 1.0 / 3.6
 CONICITY = 0.076

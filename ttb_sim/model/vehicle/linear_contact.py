@@ -54,7 +54,7 @@ from ttb_sim.model.vehicle.car import CarParameters
 from ttb_sim.model.vehicle.dofs import DOF_PER_BODY, N_DOF, WHEELSETS
 from ttb_sim.model.vehicle.matrices import contact_map, ContactMap
 import ttb_sim.model.wheel_rail as ct
-from ttb_sim.model.wheel_rail.profiles import contact_geometry_table, ContactGeometryTable
+from ttb_sim.model.wheel_rail.contact_table import contact_geometry_table, ContactGeometryTable
 
 __all__ = ['GEOMETRY_STEP', 'LinearGeometry', 'conicity_geometry', 'contact_matrices',
            'table_geometry']

@@ -84,7 +84,7 @@ from ttb_sim.model.vehicle.dofs import dofs as car_dofs
 from ttb_sim.model.vehicle.matrices import gyroscopic_matrix, train_matrices
 import ttb_sim.model.wheel_rail as ct
 from ttb_sim.model.wheel_rail.contact_parameters import ContactParameters
-from ttb_sim.model.wheel_rail.profiles import contact_geometry_table, ContactGeometryTable
+from ttb_sim.model.wheel_rail.contact_table import contact_geometry_table, ContactGeometryTable
 from ttb_sim.sim import kernels
 from ttb_sim.sim.coupling.base import FreeDofState, VehicleOutputs
 from ttb_sim.sim.integrators.protocol import Integrator
