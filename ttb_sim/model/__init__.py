@@ -13,7 +13,7 @@
 # limitations under the License.
 
 """
-The physical model: vehicles, wheel-rail contact, irregularity, track, bridge.
+The physical model: vehicles, wheel-rail contact, irregularity, track, bridge, foundations.
 
 Model modules take their own parameter records (declared with
 :func:`ttb_sim.declarations.param`) and never see the scenario tree; bad physical
