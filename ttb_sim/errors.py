@@ -33,6 +33,10 @@ class ModelError(TtbSimError, ValueError):
     """
 
 
+class FEError(ModelError):
+    """An argument given to the finite-element layer (``fe/``) is invalid (CLI exit code 2)."""
+
+
 class SimulationError(TtbSimError, RuntimeError):
     """The simulation could not be carried out (CLI exit code 1)."""
 

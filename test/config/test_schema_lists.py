@@ -18,8 +18,8 @@ from dataclasses import asdict, dataclass, field
 
 import pytest
 from ttb_sim.config import from_mapping, iter_keys, to_plain
+from ttb_sim.declarations import check_declared, param
 from ttb_sim.errors import ScenarioError
-from ttb_sim.parameters import check_declared, param
 
 
 @dataclass(frozen=True)

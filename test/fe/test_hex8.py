@@ -22,6 +22,7 @@ import numpy as np
 import pytest
 
 from ttb_sim.fe import hex8
+from ttb_sim.fe.assembly import assemble_chunked
 from ttb_sim.fe.boundary import boundary_matrix, face_matrices
 from ttb_sim.fe.interface import interface_set
 from ttb_sim.fe.mesh import graded_planes, Grid, HEX_FACES, structured_hex
@@ -50,7 +51,7 @@ def test_patch_test_linear_field_is_exact():
     """Patch test: a linear displacement on the boundary is reproduced inside (1e-10)."""
     mesh, centre = _distorted_mesh()
     n = 3 * mesh.n_nodes
-    k = hex8.assemble_chunked(n, mesh.cell_dofs(), lambda ids: hex8.stiffness(
+    k = assemble_chunked(n, mesh.cell_dofs(), lambda ids: hex8.stiffness(
         mesh.cell_coordinates(ids), np.full(len(ids), 3e7), np.full(len(ids), 0.3)))
     grad = np.array([[1e-3, 2e-4, -5e-4], [3e-4, -2e-3, 1e-4], [-1e-4, 4e-4, 7e-4]])
     exact = (mesh.nodes @ grad.T).ravel()
@@ -66,7 +67,7 @@ def test_bar_under_end_load_matches_fl_over_ea():
     grid = Grid(np.linspace(0, 5, 6), np.array([0.0, 0.5]), np.array([0.0, 0.4]))
     mesh = structured_hex(grid)
     n = 3 * mesh.n_nodes
-    k = hex8.assemble_chunked(n, mesh.cell_dofs(), lambda ids: hex8.stiffness(
+    k = assemble_chunked(n, mesh.cell_dofs(), lambda ids: hex8.stiffness(
         mesh.cell_coordinates(ids), np.full(len(ids), 2e9), np.zeros(len(ids))))
     fixed = np.concatenate([3 * mesh.node_sets['xmin'][:, None] + np.arange(3)]).ravel()
     tip = mesh.node_sets['xmax']

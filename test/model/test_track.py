@@ -26,8 +26,9 @@ import pytest
 import scipy.sparse.linalg as sla
 from ttb_sim.fe.assembly import assemble, assemble_links
 from ttb_sim.fe.beam import global_matrices, NODE_DOFS
+from ttb_sim.model.beam_line import BeamLine
 from ttb_sim.model.constants import GRAVITY
-from ttb_sim.model.track import approach_length, BeamLine, build_track, TrackParameters
+from ttb_sim.model.track import approach_length, build_track, TrackParameters
 
 TRACK = TrackParameters(model='slab')
 BRIDGE_LENGTH = 32.0

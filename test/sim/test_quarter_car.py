@@ -27,8 +27,10 @@ import math
 
 import numpy as np
 import pytest
-from ttb_sim.model.bridge import (assemble_structure, BearingParameters, BridgeParameters,
-                                  FoundationParameters, PierParameters)
+from ttb_sim.model.bearings import BearingParameters
+from ttb_sim.model.bridge import BridgeParameters, PierParameters
+from ttb_sim.model.foundation.pier_foundations import FoundationParameters
+from ttb_sim.model.structure import assemble_structure
 from ttb_sim.model.vehicle.train import Axles, QuarterCars
 from ttb_sim.sim.coupling.quarter_car.wheels import QuarterCarCoupling
 from ttb_sim.sim.integrators.newmark import Newmark

@@ -23,7 +23,7 @@ from ttb_sim.config import load_scenario
 from ttb_sim.errors import ScenarioError
 from ttb_sim.model.vehicle.dofs import dof
 import ttb_sim.model.wheel_rail as ct
-from ttb_sim.model.wheel_rail.profiles import contact_geometry_table
+from ttb_sim.model.wheel_rail.contact_table import contact_geometry_table
 from ttb_sim.sim import Simulation
 from ttb_sim.sim.coupling.train_track.equilibrium import (irregularity_under_wheels,
                                                           rail_under_wheels, wheel_geometry)

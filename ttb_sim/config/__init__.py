@@ -26,7 +26,7 @@ from ttb_sim.config.records import (car_layout, IrregularityConfig, Observer, OB
                                     OutputConfig, parse_observers, Scenario, SolverConfig,
                                     TrainConfig)
 from ttb_sim.config.schema import from_mapping, iter_keys, key_spec, to_plain
-from ttb_sim.parameters import param, Spec
+from ttb_sim.declarations import param, Spec
 
 __all__ = ['apply_overrides', 'builtin_scenarios', 'car_layout', 'config_dirs', 'from_mapping',
            'IrregularityConfig', 'iter_keys', 'key_spec', 'load_scenario', 'Observer',

@@ -16,11 +16,12 @@
 The scenario records: one frozen dataclass per section, each key declared once.
 
 A scenario is a tree of these records (:class:`Scenario` at the root).  Every
-leaf is declared with :func:`~ttb_sim.parameters.param` (default, unit, range
+leaf is declared with :func:`~ttb_sim.declarations.param` (default, unit, range
 or choices, description). The sections the model consumes are the model's own
 records: car (:class:`~ttb_sim.model.vehicle.car.CarParameters`), track, bridge,
-bearings, piers, foundation (``model/track.py``, ``model/bridge.py``), contact
-(``model/wheel_rail/parameters.py``) and the pile-soil sections soil, piles, cap,
+piers, bearings, foundation (``model/track.py``, ``model/bridge.py``,
+``model/bearings.py``, ``model/foundation/pier_foundations.py``), contact
+(``model/wheel_rail/contact_parameters.py``) and the pile-soil sections soil, piles, cap,
 interface and load (``model/foundation/records.py``); the rest (train, irregularity, solver,
 output) are declared here.  Rules that involve more
 than one key are checked when a :class:`Scenario` is made.
@@ -36,17 +37,19 @@ import re
 from typing import Any, Sequence
 
 from ttb_sim.config.schema import to_plain
+from ttb_sim.declarations import param
 from ttb_sim.errors import ScenarioError
 from ttb_sim.inputs import shown
-from ttb_sim.model.bridge import (BearingParameters, BridgeParameters, FoundationParameters,
-                                  PierParameters, span_frequency)
-from ttb_sim.model.foundation.records import (Cap, check_substructure, Interface, Observation,
-                                              PileGroup, PileLoad, SoilParameters, Substructure)
-from ttb_sim.model.foundation.substructure import planned_nodes
+from ttb_sim.model.bearings import BearingParameters
+from ttb_sim.model.bridge import BridgeParameters, PierParameters, span_frequency
+from ttb_sim.model.foundation.consistency import check_substructure
+from ttb_sim.model.foundation.pier_foundations import FoundationParameters
+from ttb_sim.model.foundation.records import (Cap, Interface, Observation, PileGroup, PileLoad,
+                                              SoilParameters, Substructure)
+from ttb_sim.model.foundation.soil_mesh import planned_nodes
 from ttb_sim.model.track import track_extent, TrackExtent, TrackParameters
 from ttb_sim.model.vehicle.car import CarParameters
-from ttb_sim.model.wheel_rail.parameters import ContactParameters
-from ttb_sim.parameters import param
+from ttb_sim.model.wheel_rail.contact_parameters import ContactParameters
 
 
 @dataclass(frozen=True)

@@ -15,7 +15,7 @@
 """
 The schema walker: every declared key of the scenario tree, and typed, range-checked values.
 
-:func:`iter_keys` and :func:`key_spec` walk the :func:`~ttb_sim.parameters.param`
+:func:`iter_keys` and :func:`key_spec` walk the :func:`~ttb_sim.declarations.param`
 declarations of the scenario records; :func:`from_mapping` builds the record
 tree from plain (YAML) data, checking each value against its declaration and
 naming the key path, the value and what is allowed when it refuses.
@@ -29,9 +29,9 @@ import sys
 import typing
 from typing import Any, Iterator, Mapping
 
+from ttb_sim.declarations import Spec
 from ttb_sim.errors import ModelError, ScenarioError
 from ttb_sim.inputs import shown
-from ttb_sim.parameters import Spec
 
 __all__ = ['ALIASES', 'canonical_key', 'from_mapping', 'iter_keys', 'key_spec',
            'resolve_aliases', 'to_plain']

@@ -15,11 +15,14 @@
 """
 Finite elements without physics names: elements, assembly, numbering, factorisation.
 
-``beam`` (3-D Euler-Bernoulli), ``mindlin`` (MITC4 plate), ``assembly`` (COO-once
-sparse assembly and spring-dashpot links), ``dofs`` (:class:`DofMap`: full/free
-numbering, substructure blocks and interfaces), ``factorization`` (symmetric sparse
-direct solvers behind one function), ``bisection`` (a long matrix solved as two halves on
-two cores), ``compiled`` (numba compilation of the package's kernels).
+``beam`` (3-D Euler-Bernoulli), ``mindlin`` (MITC4 plate), ``hex8`` (trilinear
+hexahedron), ``quad`` and ``interface`` (4-node faces, Desai thin-layer elements),
+``boundary`` (viscous-spring boundary faces), ``mesh`` (hexahedral meshes: nodes, cells,
+named sets; structured grids and their cuts), ``assembly`` (the one COO-once sparse
+assembler, chunked for large meshes, and spring-dashpot links), ``dofs`` (:class:`DofMap`:
+full/free numbering, substructure blocks and interfaces), ``factorization`` (symmetric
+sparse direct solvers behind one function), ``bisection`` (a long matrix solved as two
+halves on two cores), ``compiled`` (numba compilation of the package's kernels).
 """
 
 from ttb_sim.fe.assembly import assemble, assemble_links, link_kinematics

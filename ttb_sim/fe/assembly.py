@@ -12,9 +12,21 @@
 # See the License for the specific language governing permissions and
 # limitations under the License.
 
-"""Sparse assembly of element matrices and point springs with rigid arms."""
+"""
+Sparse assembly: element matrices, dense blocks and point springs with rigid arms.
+
+:func:`assemble` is the one assembler of the package: the COO triplets of all
+the element matrices it is given, converted to CSR (duplicates summed) once.
+Everything square that is assembled goes through it: beam, plate, boundary-face
+and spring-link matrices, a dense block on some DOFs (one element), diagonal
+springs (1 x 1 elements), and, chunk by chunk, the solid elements of a large
+mesh (:func:`assemble_chunked`, so that the triplets of a large mesh never all
+sit in memory together).
+"""
 
 from __future__ import annotations
+
+from typing import Callable
 
 import numpy as np
 import scipy.sparse as sp
@@ -44,6 +56,50 @@ def assemble(n_dofs: int, dofs: np.ndarray, matrices: np.ndarray) -> sp.csr_matr
     cols = np.tile(dofs, (1, n_local)).ravel()
     return sp.coo_matrix((np.asarray(matrices).ravel(), (rows, cols)),
                          shape=(n_dofs, n_dofs)).tocsr()
+
+
+def assemble_chunked(n_dofs: int, dofs: np.ndarray,
+                     kernel: Callable[[np.ndarray], np.ndarray],
+                     chunk: int = 20000, dtype: type = float) -> sp.csr_matrix:
+    """
+    Assemble element matrices computed chunk by chunk into one CSR matrix.
+
+    Each chunk is assembled by :func:`assemble` and the chunks' matrices are
+    summed in order.
+
+    Parameters
+    ----------
+    n_dofs : int
+        Size of the global matrix.
+    dofs : array of int, shape (m, n_local)
+        Global DOFs of each element.
+    kernel : callable
+        ``kernel(element_ids) -> matrices (k, n_local, n_local)``.
+    chunk : int
+        Elements per chunk.
+    dtype : type
+        Data type of the matrix (complex lets two matrices share one pattern).
+
+    """
+    dofs = np.asarray(dofs)
+    total = sp.csr_matrix((n_dofs, n_dofs), dtype=dtype)
+    index_type = np.int32 if n_dofs < 2**31 else np.int64
+    for start in range(0, len(dofs), chunk):
+        ids = np.arange(start, min(start + chunk, len(dofs)))
+        total = total + assemble(n_dofs, dofs[ids].astype(index_type),
+                                 kernel(ids).astype(dtype))
+    total.sum_duplicates()
+    return total
+
+
+def dense_block(n_dofs: int, dofs: np.ndarray, block: np.ndarray) -> sp.csr_matrix:
+    """Return a dense (k, k) ``block`` on the global DOFs ``dofs`` (k,) as an n_dofs matrix."""
+    return assemble(n_dofs, np.asarray(dofs)[None, :], np.asarray(block)[None])
+
+
+def diagonal(n_dofs: int, dofs: np.ndarray, values: np.ndarray) -> sp.csr_matrix:
+    """Return point springs (or dashpots, masses) ``values`` (k,) on the DOFs ``dofs`` (k,)."""
+    return assemble(n_dofs, np.asarray(dofs)[:, None], np.asarray(values)[:, None, None])
 
 
 def skew(r: np.ndarray) -> np.ndarray:

@@ -35,6 +35,8 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike
 
+from ttb_sim.errors import FEError
+
 NODE_DOFS = 6
 ELEMENT_DOFS = 12
 _GAUSS_X, _GAUSS_W = np.polynomial.legendre.leggauss(4)
@@ -97,7 +99,7 @@ def hermite(xi: ArrayLike, length: ArrayLike, derivative: int = 0) -> np.ndarray
     elif derivative == 2:
         h = [-6 + 12 * xi, -4 + 6 * xi, 6 - 12 * xi, -2 + 6 * xi]
     else:
-        raise ValueError(f'derivative must be 0, 1 or 2, got {derivative}')
+        raise FEError(f'derivative must be 0, 1 or 2, got {derivative}')
     scale = length ** (-derivative)
     return np.stack([h[0] * scale, h[1] * length * scale, h[2] * scale,
                      h[3] * length * scale], axis=-1)
@@ -235,7 +237,7 @@ def field_rows(xi: np.ndarray, length: np.ndarray, derivative: int = 0) -> np.nd
 
     """
     if derivative not in (0, 1):
-        raise ValueError(f'derivative must be 0 or 1, got {derivative}')
+        raise FEError(f'derivative must be 0 or 1, got {derivative}')
     xi = np.asarray(xi, dtype=float)
     length = np.broadcast_to(np.asarray(length, dtype=float), xi.shape)
     out = np.zeros(xi.shape + (6, ELEMENT_DOFS))

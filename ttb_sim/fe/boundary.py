@@ -33,6 +33,7 @@ from typing import Literal
 import numpy as np
 import scipy.sparse as sp
 
+from ttb_sim.errors import FEError
 from ttb_sim.fe.assembly import assemble
 from ttb_sim.fe.quad import face_frames, FACE_N
 
@@ -89,18 +90,39 @@ def face_matrices(coords: np.ndarray, normal_value: np.ndarray,
             out[:, 3 * a:3 * a + 3, 3 * a:3 * a + 3] = nodal[:, a]
         return out
     if lumping != 'consistent':
-        raise ValueError(f"lumping must be 'lumped' or 'consistent', not {lumping!r}")
+        raise FEError(f"lumping must be 'lumped' or 'consistent', not {lumping!r}")
     nn = np.einsum('ga,gb,eg,egij->eaibj', FACE_N, FACE_N, weights, block)
     return nn.reshape(len(coords), 12, 12)
 
 
 def boundary_matrix(n_dofs: int, nodes: np.ndarray, faces: np.ndarray,
                     normal_value: np.ndarray, tangential_value: np.ndarray,
-                    lumping: Lumping = 'lumped') -> sp.csr_matrix:
-    """Assemble oriented per-area springs (or dashpots) on faces into an n_dofs matrix."""
+                    lumping: Lumping = 'lumped',
+                    coords: np.ndarray | None = None) -> sp.csr_matrix:
+    """
+    Assemble oriented per-area springs (or dashpots) on faces into an n_dofs matrix.
+
+    Parameters
+    ----------
+    n_dofs : int
+        Size of the global matrix (3 DOFs per node).
+    nodes : array, shape (n, 3)
+        Node coordinates (m).
+    faces : array of int, shape (k, 4)
+        Node ids of the faces.
+    normal_value, tangential_value : arrays, shape (k,)
+        Per-area value normal and tangential to each face.
+    lumping : {'lumped', 'consistent'}
+        See :func:`face_matrices`.
+    coords : array, shape (k, 4, 3), optional
+        The faces' corner coordinates where they are not ``nodes[faces]`` (the
+        faces of a periodic mesh, whose tied nodes do not move the corners).
+
+    """
     faces = np.asarray(faces)
     if len(faces) == 0:
         return sp.csr_matrix((n_dofs, n_dofs))
-    mats = face_matrices(nodes[faces], normal_value, tangential_value, lumping)
+    mats = face_matrices(nodes[faces] if coords is None else coords, normal_value,
+                         tangential_value, lumping)
     dofs = (3 * faces[:, :, None] + np.arange(3)).reshape(len(faces), 12)
     return assemble(n_dofs, dofs, mats)

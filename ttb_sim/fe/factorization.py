@@ -54,6 +54,7 @@ import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as sla
 
+from ttb_sim.errors import FEError
 from ttb_sim.fe import compiled
 from ttb_sim.fe.bisection import BisectedFactorization, level_bisection
 
@@ -95,13 +96,13 @@ def resolve(method: str) -> str:
 
     Raises
     ------
-    ValueError
+    FEError
         For an unknown method name (the message lists the allowed ones).
 
     """
     if method not in METHODS:
         message = f'unknown factorisation method {method!r}; allowed: {", ".join(METHODS)}'
-        raise ValueError(message)
+        raise FEError(message)
     if available(method):
         return method
     return next(m for m in FALLBACKS if available(m))
@@ -134,7 +135,7 @@ def factorize(matrix: sp.spmatrix | sp.sparray, *, method: str = 'superlu',
 
     Raises
     ------
-    ValueError
+    FEError
         For an unknown method, a non-square matrix, or a matrix that is not
         symmetric for a symmetric method.
 
@@ -145,7 +146,7 @@ def factorize(matrix: sp.spmatrix | sp.sparray, *, method: str = 'superlu',
                     method, _PACKAGES[method], used)
     shape = matrix.shape
     if len(shape) != 2 or shape[0] != shape[1]:
-        raise ValueError(f'factorize needs a square matrix, got shape {shape}')
+        raise FEError(f'factorize needs a square matrix, got shape {shape}')
     if used == 'superlu':
         return _SuperLU(sla.splu(sp.csc_matrix(matrix)), used)
     csc = sp.csc_matrix(matrix)
@@ -172,7 +173,7 @@ def _check_symmetric(matrix: sp.csc_matrix, method: str) -> None:
     if asymmetry > SYMMETRY_TOLERANCE * scale:
         message = (f'method {method!r} needs a symmetric matrix; max |A - A^T| = '
                    f'{asymmetry:.3g} against max |A| = {scale:.3g}')
-        raise ValueError(message)
+        raise FEError(message)
 
 
 class _SuperLU:

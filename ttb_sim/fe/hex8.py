@@ -23,17 +23,15 @@ density rho (kg/m^3). Strains are in Voigt order (xx, yy, zz, yz, xz, xy) with
 engineering shear strains.
 
 Lumped masses are the row sums of the consistent mass (for a parallelepiped,
-one eighth of the element mass at each node). Assembly collects COO triplets
-in chunks of elements and converts each chunk to CSR once, so the triplets of
-a large mesh never all sit in memory together.
+one eighth of the element mass at each node). The element matrices of a mesh
+are assembled by :func:`ttb_sim.fe.assembly.assemble_chunked`.
 """
 
 from __future__ import annotations
 
-from typing import Callable
-
 import numpy as np
-import scipy.sparse as sp
+
+from ttb_sim.errors import FEError
 
 _G = 1.0 / np.sqrt(3.0)
 #: Natural coordinates of the node corners.
@@ -84,8 +82,8 @@ def _jacobians(coords: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     jac = np.einsum('gai,eaj->egij', _DN, coords)
     det = np.linalg.det(jac)
     if np.any(det <= 0):
-        raise ValueError('hexahedron with a non-positive Jacobian (inverted or '
-                         'badly ordered nodes)')
+        raise FEError('hexahedron with a non-positive Jacobian (inverted or '
+                      'badly ordered nodes)')
     grad = np.einsum('egij,gaj->egai', np.linalg.inv(jac), _DN)
     return grad, det
 
@@ -174,39 +172,3 @@ def lumped_mass(coords: np.ndarray, density: np.ndarray) -> np.ndarray:
     _, det = _jacobians(np.asarray(coords, dtype=float))
     return np.einsum('ga,eg->ea', _N, det * GAUSS_WEIGHTS) * \
         np.asarray(density, dtype=float)[:, None]
-
-
-def assemble_chunked(n_dofs: int, dofs: np.ndarray,
-                     kernel: Callable[[np.ndarray], np.ndarray],
-                     chunk: int = 20000, dtype: type = float) -> sp.csr_matrix:
-    """
-    Assemble element matrices computed chunk by chunk into one CSR matrix.
-
-    Parameters
-    ----------
-    n_dofs : int
-        Size of the global matrix.
-    dofs : array of int, shape (m, n_local)
-        Global DOFs of each element.
-    kernel : callable
-        ``kernel(element_ids) -> matrices (k, n_local, n_local)``.
-    chunk : int
-        Elements per chunk.
-    dtype : type
-        Data type of the matrix (complex lets two matrices share one pattern).
-
-    """
-    dofs = np.asarray(dofs)
-    n_local = dofs.shape[1]
-    total = sp.csr_matrix((n_dofs, n_dofs), dtype=dtype)
-    index_type = np.int32 if n_dofs < 2**31 else np.int64
-    for start in range(0, len(dofs), chunk):
-        ids = np.arange(start, min(start + chunk, len(dofs)))
-        d = dofs[ids].astype(index_type)
-        rows = np.repeat(d, n_local, axis=1).ravel()
-        cols = np.tile(d, (1, n_local)).ravel()
-        part = sp.coo_matrix((kernel(ids).ravel().astype(dtype), (rows, cols)),
-                             shape=(n_dofs, n_dofs)).tocsr()
-        total = total + part
-    total.sum_duplicates()
-    return total

@@ -43,6 +43,7 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.sparse as sp
 
+from ttb_sim.errors import FEError
 from ttb_sim.fe.quad import face_frames, FACE_N
 
 
@@ -138,7 +139,7 @@ def interface_set(nodes: np.ndarray, faces_a: np.ndarray, faces_b: np.ndarray,
     k = len(faces_a)
     t = np.broadcast_to(np.asarray(thickness, dtype=float), (k,)).copy()
     if np.any(t <= 0):
-        raise ValueError(f'interface thickness must be > 0 m, got min {t.min() if k else 0:g}')
+        raise FEError(f'interface thickness must be > 0 m, got min {t.min() if k else 0:g}')
     if k == 0:
         return InterfaceSet(faces_a, faces_b, np.zeros((0, 4, 3, 3)), np.zeros((0, 4)), t,
                             sp.csr_matrix((0, n_dofs)))

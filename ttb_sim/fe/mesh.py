@@ -21,9 +21,12 @@ Faces are stored as four node ids ordered so that (x1 - x0) x (x3 - x0) points
 out of the cell they were taken from (:data:`HEX_FACES`).
 
 :func:`structured_hex` builds a brick mesh from three sorted lists of
-coordinate planes, and :func:`graded_planes` makes such lists: nodes at given
-coordinates, a size ``h`` inside given zones, growing by a factor per element
-away from them up to ``h_max``.
+coordinate planes, :func:`grid_cells` the mesh of some of the cells of such a
+grid (:class:`GridCells`: the nodes renumbered over the cells kept, optionally
+periodic, with each cell's neighbours and outer faces), and
+:func:`graded_planes` makes such lists: nodes at given coordinates, a size
+``h`` inside given zones, growing by a factor per element away from them up to
+``h_max``.
 """
 
 from __future__ import annotations
@@ -34,6 +37,8 @@ from typing import Sequence
 
 import numpy as np
 
+from ttb_sim.errors import FEError
+
 #: Local node ids of the six faces of a hexahedron, outward oriented:
 #: -x, +x, -y, +y, -z, +z.
 HEX_FACES = np.array([[0, 4, 7, 3], [1, 2, 6, 5], [0, 1, 5, 4],
@@ -41,6 +46,14 @@ HEX_FACES = np.array([[0, 4, 7, 3], [1, 2, 6, 5], [0, 1, 5, 4],
 
 #: Names of the six faces of :data:`HEX_FACES`.
 FACE_NAMES = ('xmin', 'xmax', 'ymin', 'ymax', 'zmin', 'zmax')
+
+#: Step (di, dj, dk) from a cell of a grid to its neighbour across each face of
+#: :data:`HEX_FACES`.
+FACE_STEPS = ((-1, 0, 0), (1, 0, 0), (0, -1, 0), (0, 1, 0), (0, 0, -1), (0, 0, 1))
+
+#: Grid offsets (di, dj, dk) of the eight nodes of a cell, in the node order of a cell.
+CELL_CORNERS = np.array([[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0],
+                         [0, 0, 1], [1, 0, 1], [1, 1, 1], [0, 1, 1]])
 
 
 @dataclass
@@ -162,7 +175,7 @@ class Grid:
 
         Raises
         ------
-        ValueError
+        FEError
             If a point lies outside the grid.
 
         """
@@ -175,7 +188,7 @@ class Grid:
             if np.any(p < planes[0] - tol) or np.any(p > planes[-1] + tol):
                 message = (f'points {points.tolist()} lie outside the grid '
                            f'[{planes[0]:g}, {planes[-1]:g}] along axis {"xyz"[axis]}')
-                raise ValueError(message)
+                raise FEError(message)
             i = np.clip(np.searchsorted(planes, p, side='right') - 1, 0, len(planes) - 2)
             index.append(i)
             local.append(2.0 * (p - planes[i]) / (planes[i + 1] - planes[i]) - 1.0)
@@ -193,10 +206,8 @@ def structured_hex(grid: Grid) -> Mesh:
     z, y, x = np.meshgrid(grid.zs, grid.ys, grid.xs, indexing='ij')
     nodes = np.column_stack([x.ravel(), y.ravel(), z.ravel()])
     i, j, k = grid.cell_index()
-    corner = np.array([[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0],
-                       [0, 0, 1], [1, 0, 1], [1, 1, 1], [0, 1, 1]])
-    cells = grid.node_id(i[:, None] + corner[:, 0], j[:, None] + corner[:, 1],
-                         k[:, None] + corner[:, 2])
+    cells = grid.node_id(i[:, None] + CELL_CORNERS[:, 0], j[:, None] + CELL_CORNERS[:, 1],
+                         k[:, None] + CELL_CORNERS[:, 2])
     mesh = Mesh(nodes, cells, np.zeros(len(cells), dtype=int))
     cx, cy, cz = grid.cell_shape
     on_face = (i == 0, i == cx - 1, j == 0, j == cy - 1, k == 0, k == cz - 1)
@@ -207,6 +218,93 @@ def structured_hex(grid: Grid) -> Mesh:
         mesh.face_sets[name] = cells[on_face[f]][:, HEX_FACES[f]]
         mesh.node_sets[name] = np.flatnonzero(node_on[f])
     return mesh
+
+
+@dataclass(frozen=True)
+class GridCells:
+    """
+    Some of the cells of a :class:`Grid` as an unstructured mesh.
+
+    Attributes
+    ----------
+    grid : Grid
+        The grid the cells were taken from.
+    nodes : array, shape (n, 3)
+        Coordinates of the nodes the cells use (m), in grid-node order.
+    cells : array of int, shape (m, 8)
+        Node ids of each cell, in grid-cell order.
+    coordinates : array, shape (m, 8, 3)
+        Corner coordinates of each cell (m): ``nodes[cells]`` but for periodic
+        ties, which join nodes without moving the cells' corners.
+    index : tuple of three arrays of int, shape (m,)
+        Grid index (i, j, k) of each cell.
+    cell_map : array of int, shape (n_grid_cells,)
+        Cell of each grid cell, -1 where the grid cell was dropped.
+
+    """
+
+    grid: Grid
+    nodes: np.ndarray
+    cells: np.ndarray
+    coordinates: np.ndarray
+    index: tuple[np.ndarray, np.ndarray, np.ndarray]
+    cell_map: np.ndarray
+
+    def on_outer_face(self, face: int) -> np.ndarray:
+        """Return the mask of cells whose face ``face`` (:data:`HEX_FACES` order) is outside."""
+        i, j, k = self.index
+        cx, cy, cz = self.grid.cell_shape
+        return (i == 0, i == cx - 1, j == 0, j == cy - 1, k == 0, k == cz - 1)[face]
+
+    def neighbours(self, cells: np.ndarray, face: int) -> np.ndarray:
+        """Return the cell across face ``face`` of each of ``cells``, -1 outside or dropped."""
+        cx, cy, cz = self.grid.cell_shape
+        di, dj, dk = FACE_STEPS[face]
+        ci, cj, ck = self.index
+        ni, nj, nk = ci[cells] + di, cj[cells] + dj, ck[cells] + dk
+        inside = (ni >= 0) & (ni < cx) & (nj >= 0) & (nj < cy) & (nk >= 0) & (nk < cz)
+        neighbour = np.full(len(cells), -1)
+        neighbour[inside] = self.cell_map[self.grid.cell_id(ni[inside], nj[inside],
+                                                            nk[inside])]
+        return neighbour
+
+
+def grid_cells(grid: Grid, keep: np.ndarray, periodic: bool = False) -> GridCells:
+    """
+    Return the cells of ``grid`` that ``keep`` selects, on the nodes they use.
+
+    Parameters
+    ----------
+    grid : Grid
+        The coordinate planes.
+    keep : array of bool, shape (n_grid_cells,)
+        The grid cells to keep, in grid-cell order.
+    periodic : bool
+        Tie the nodes of the last x and y planes to those of the first (a
+        laterally periodic block); the cells' corner coordinates stay.
+
+    """
+    nx, ny, nz = grid.shape
+    ci, cj, ck = grid.cell_index()
+    ii = ci[:, None] + CELL_CORNERS[:, 0]
+    jj = cj[:, None] + CELL_CORNERS[:, 1]
+    kk = ck[:, None] + CELL_CORNERS[:, 2]
+    zg, yg, xg = np.meshgrid(grid.zs, grid.ys, grid.xs, indexing='ij')
+    all_xyz = np.column_stack([xg.ravel(), yg.ravel(), zg.ravel()])
+    coordinates = all_xyz[grid.node_id(ii, jj, kk)[keep]]
+    if periodic:
+        ii = np.where(ii == nx - 1, 0, ii)
+        jj = np.where(jj == ny - 1, 0, jj)
+    structured_cells = grid.node_id(ii, jj, kk)
+    kept = np.flatnonzero(keep)
+    cell_map = np.full(len(ci), -1)
+    cell_map[kept] = np.arange(len(kept))
+    cells_s = structured_cells[kept]
+    used = np.unique(cells_s)
+    node_map = np.full(nx * ny * nz, -1)
+    node_map[used] = np.arange(len(used))
+    return GridCells(grid, all_xyz[used], node_map[cells_s], coordinates,
+                     (ci[kept], cj[kept], ck[kept]), cell_map)
 
 
 def graded_planes(start: float, stop: float, keys: Sequence[float],

@@ -45,6 +45,7 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.sparse as sp
 
+from ttb_sim.errors import FEError
 from ttb_sim.fe.assembly import assemble
 
 NODE_DOFS = 3
@@ -163,7 +164,7 @@ def rectangular_mesh(x: np.ndarray, y: np.ndarray) -> PlateMesh:
     x = np.asarray(x, dtype=float)
     y = np.asarray(y, dtype=float)
     if np.any(np.diff(x) <= 0) or np.any(np.diff(y) <= 0):
-        raise ValueError('grid lines must be strictly ascending')
+        raise FEError('grid lines must be strictly ascending')
     nx = x.size
     xx, yy = np.meshgrid(x, y)
     i, j = np.meshgrid(np.arange(nx - 1), np.arange(y.size - 1))

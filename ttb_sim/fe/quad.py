@@ -24,6 +24,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from ttb_sim.errors import FEError
+
 _G = 1.0 / np.sqrt(3.0)
 #: Natural coordinates of the face corners.
 FACE_CORNERS = np.array([[-1, -1], [1, -1], [1, 1], [-1, 1]], dtype=float)
@@ -74,7 +76,7 @@ def face_frames(coords: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     normal = np.cross(t[:, :, 0], t[:, :, 1])
     area = np.linalg.norm(normal, axis=2)
     if np.any(area <= 0):
-        raise ValueError('degenerate face (zero area)')
+        raise FEError('degenerate face (zero area)')
     n = normal / area[..., None]
     s1 = t[:, :, 0] / np.linalg.norm(t[:, :, 0], axis=2)[..., None]
     s2 = np.cross(n, s1)

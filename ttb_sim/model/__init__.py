@@ -13,9 +13,9 @@
 # limitations under the License.
 
 """
-The physical model: vehicles, wheel-rail contact, irregularity, track, bridge.
+The physical model: vehicles, wheel-rail contact, irregularity, track, bridge, foundations.
 
 Model modules take their own parameter records (declared with
-:func:`ttb_sim.parameters.param`) and never see the scenario tree; bad physical
+:func:`ttb_sim.declarations.param`) and never see the scenario tree; bad physical
 arguments raise :class:`ttb_sim.errors.ModelError`.
 """

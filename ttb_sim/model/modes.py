@@ -34,6 +34,8 @@ import scipy.linalg as la
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
+from ttb_sim.errors import ModelError
+
 
 __all__ = ['DENSE_LIMIT', 'Modes', 'natural_modes']
 
@@ -69,15 +71,15 @@ def natural_modes(mass: Any, stiffness: Any, damping: Any, around: float,
 
     Raises
     ------
-    ValueError
+    ModelError
         For a count or centre outside those ranges.
 
     """
     n = mass.shape[0]
     if not (isinstance(count, (int, np.integer)) and 1 <= count <= n):
-        raise ValueError(f'count = {count}: allowed values are 1 to {n} (the free DOFs)')
+        raise ModelError(f'count = {count}: allowed values are 1 to {n} (the free DOFs)')
     if not (math.isfinite(around) and around >= 0.0):
-        raise ValueError(f'around = {around}: allowed values are finite and >= 0 Hz')
+        raise ModelError(f'around = {around}: allowed values are finite and >= 0 Hz')
     sigma = (2.0 * math.pi * around) ** 2
     if n <= DENSE_LIMIT or count >= n - 1:
         k_d, m_d = (a.toarray() if sp.issparse(a) else np.asarray(a) for a in (stiffness, mass))

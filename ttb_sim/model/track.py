@@ -31,6 +31,10 @@ base plate, the filling layer, the slab and the rail, stacked; the rails' axes
 are at +/- ``rail_semi_spacing``. On the approaches the ground surface is at the
 girder-top height. Track displacements, like the bridge's, are increments over
 the dead-load state.
+
+:func:`build_track` places the stations (fasteners, rail, slab and base nodes),
+builds the beams and their :class:`~.beam_line.BeamLine` lookups, and the links
+of :mod:`.track_links` (fasteners, the slab-base and base-girder layers).
 """
 
 from __future__ import annotations
@@ -40,9 +44,10 @@ import math
 
 import numpy as np
 
-from ttb_sim.fe.assembly import link_kinematics
-from ttb_sim.fe.beam import BeamSection, field_rows, NODE_DOFS, offset_rows, point_rows
-from ttb_sim.parameters import check_declared, param
+from ttb_sim.declarations import check_declared, param
+from ttb_sim.fe.beam import BeamSection, NODE_DOFS
+from ttb_sim.model.beam_line import BeamLine
+from ttb_sim.model.track_links import layer, LinkSet, node_dof_rows, node_link
 
 
 @dataclass(frozen=True)
@@ -127,113 +132,6 @@ class TrackParameters:
 
 POISSON_CONCRETE = 0.2
 STEEL_DENSITY = 7850.0
-GAUSS_POINTS = 3
-_GX, _GW = np.polynomial.legendre.leggauss(GAUSS_POINTS)
-
-
-@dataclass(frozen=True)
-class BeamLine:
-    """
-    Elements of one beam along x (possibly in separate units), for point lookups.
-
-    Attributes
-    ----------
-    start : numpy.ndarray
-        (n_el,) x of each element's first node (ascending).
-    length : numpy.ndarray
-        (n_el,) element lengths (m).
-    dofs : numpy.ndarray
-        (n_el, 12) full DOF indices of each element.
-    z : float
-        Height of the beam axis (m).
-    y : float
-        Lateral position of the beam axis (m).
-    section : BeamSection or None
-        Section of each element (the rails carry theirs: a wheel load inside an
-        element deflects it beyond the nodes' interpolation,
-        :func:`ttb_sim.fe.beam.interior_compliance`).
-
-    """
-
-    start: np.ndarray
-    length: np.ndarray
-    dofs: np.ndarray
-    z: float
-    y: float = 0.0
-    section: BeamSection | None = None
-
-    @property
-    def end(self) -> float:
-        """Return x of the last node (m)."""
-        return float(self.start[-1] + self.length[-1])
-
-    def locate(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """
-        Return (element, xi, inside) for positions x along the track.
-
-        ``inside`` is False in the gaps between units and beyond the ends; the
-        element is then the nearest one to the left (or the first).
-        """
-        x = np.asarray(x, dtype=float)
-        element = np.clip(np.searchsorted(self.start, x, side='right') - 1, 0,
-                          self.start.size - 1)
-        local = x - self.start[element]
-        inside = (local >= 0.0) & (local <= self.length[element] * (1 + 1e-12))
-        xi = np.clip(local / self.length[element], 0.0, 1.0)
-        return element, xi, inside
-
-    def rows(self, x: np.ndarray, arm: np.ndarray,
-             derivative: int = 0) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """
-        Return the rows of the motion of points at ``arm`` from the beam axis.
-
-        Returns
-        -------
-        (element, rows (n, 3, 12), inside); rows are zero outside the beam.
-
-        """
-        element, xi, inside = self.locate(x)
-        r = point_rows(xi, self.length[element], arm, derivative)
-        return element, r * inside[:, None, None], inside
-
-    def link_rows(self, x: np.ndarray, arm: np.ndarray
-                  ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """
-        Return what a spring link needs from points at ``arm`` from the beam axis.
-
-        Returns
-        -------
-        (full DOFs (n, 12), rows (n, 4, 12) of the x, y, z motion and the roll,
-        inside); rows are zero outside the beam.
-
-        """
-        element, xi, inside = self.locate(x)
-        f = field_rows(xi, self.length[element])
-        rows = np.concatenate([offset_rows(f, arm), f[:, 3:4, :]], axis=1)
-        return self.dofs[element], rows * inside[:, None, None], inside
-
-
-@dataclass(frozen=True)
-class LinkSet:
-    """
-    Spring-dashpot links between DOFs: discrete fasteners or quadrature points of a layer.
-
-    Attributes
-    ----------
-    dofs : numpy.ndarray
-        (n, n_local) full DOFs; -1 stands for rigid ground.
-    kinematics : numpy.ndarray
-        (n, 4, n_local) rows of the relative x, y, z displacement and roll.
-    stiffness, damping : numpy.ndarray
-        (n, 4) per direction (N/m, N m/rad; N s/m, N m s/rad), quadrature
-        weights included.
-
-    """
-
-    dofs: np.ndarray
-    kinematics: np.ndarray
-    stiffness: np.ndarray
-    damping: np.ndarray
 
 
 @dataclass(frozen=True)
@@ -327,6 +225,144 @@ def track_extent(track: TrackParameters, bridge_length: float,
                        n_units=n_units)
 
 
+@dataclass(frozen=True)
+class _Stations:
+    """Where the track's nodes are along x, and the heights of its beams (m)."""
+
+    x_fast: np.ndarray
+    """(n_fasteners,) fastener positions (rails run from the first to the last)."""
+    x_rail: np.ndarray
+    """Rail node positions, ``rail_elements_per_bay`` elements per fastener bay."""
+    x_slab: np.ndarray
+    """Slab / base nodes: per unit its start, the fasteners, its end."""
+    per_unit: int
+    """Slab / base nodes per unit."""
+    z_rail: float
+    z_slab: float
+    z_base: float
+
+
+def _stations(track: TrackParameters, extent: TrackExtent) -> _Stations:
+    """Return the node positions of rails, slabs and base plates and the beams' heights."""
+    s, n_f = track.fastener_spacing, track.fasteners_per_slab
+    pitch = n_f * s
+    margin = 0.5 * (s - track.slab_gap)
+    x0, n_units = extent.unit_start, extent.n_units
+
+    # Heights of the layer stack.
+    h_g = track.girder_top_height
+    z_base = h_g + 0.5 * track.base_thickness
+    z_slab = h_g + track.base_thickness + track.filling_thickness + 0.5 * track.slab_thickness
+    z_rail = z_slab + 0.5 * track.slab_thickness + 0.5 * track.rail_height
+
+    # Fasteners and rail nodes (rails run from the first to the last fastener).
+    unit0 = x0 + np.arange(n_units) * pitch
+    x_fast = (unit0[:, None] + margin + np.arange(n_f)[None, :] * s).ravel()
+    n_e = track.rail_elements_per_bay
+    h = s / n_e
+    n_rail_nodes = (x_fast.size - 1) * n_e + 1
+    x_rail = x_fast[0] + np.arange(n_rail_nodes) * h
+
+    # Slab / base nodes per unit: unit start, the fasteners, unit end.
+    unit_len = pitch - track.slab_gap
+    x_unit = np.concatenate([np.zeros((n_units, 1)),
+                             margin + np.arange(n_f)[None, :] * s * np.ones((n_units, 1)),
+                             np.full((n_units, 1), unit_len)], axis=1) + unit0[:, None]
+    return _Stations(x_fast, x_rail, x_unit.ravel(), n_f + 2, z_rail, z_slab, z_base)
+
+
+@dataclass(frozen=True)
+class _Beams:
+    """The track's beam elements: left rail, right rail, slab, base (global numbering)."""
+
+    coords: np.ndarray
+    elements: np.ndarray
+    section: BeamSection
+    ids: tuple[np.ndarray, ...]
+    """Node numbers of each beam."""
+    pairs: tuple[np.ndarray, ...]
+    """(n_el, 2) node numbers of each beam's elements."""
+    sections: tuple[BeamSection, ...]
+    """Section of each beam."""
+
+
+def _track_beams(track: TrackParameters, st: _Stations, first_node: int) -> _Beams:
+    """Return the rails, the slabs and the base plates as beams from node ``first_node`` on."""
+    coords, conn, sections = [], [], []
+    node = first_node
+
+    def add_line(x: np.ndarray, y: float, z: float, breaks: int | None) -> np.ndarray:
+        nonlocal node
+        ids = node + np.arange(x.size)
+        coords.append(np.column_stack([x, np.full(x.size, y), np.full(x.size, z)]))
+        pairs = np.column_stack([ids[:-1], ids[1:]])
+        if breaks:
+            keep = (np.arange(x.size - 1) % breaks) != breaks - 1
+            pairs = pairs[keep]
+        conn.append(pairs)
+        node += x.size
+        return ids
+
+    e_r = track.rail_young_modulus
+    rail_ids = []
+    for side in (1.0, -1.0):
+        ids = add_line(st.x_rail, side * track.rail_semi_spacing, st.z_rail, None)
+        n = ids.size - 1
+        sections.append(BeamSection(
+            np.full(n, e_r * track.rail_mass / STEEL_DENSITY),
+            np.full(n, track.rail_torsional_stiffness),
+            np.full(n, e_r * track.rail_inertia_y), np.full(n, e_r * track.rail_inertia_z),
+            np.full(n, track.rail_mass),
+            np.full(n, STEEL_DENSITY * track.rail_polar_inertia)))
+        rail_ids.append(ids)
+    fill_mass = 0.5 * track.concrete_density * track.slab_width * track.filling_thickness
+    slab_ids = add_line(st.x_slab, 0.0, st.z_slab, st.per_unit)
+    sections.append(_rect_section(conn[-1].shape[0], track.slab_young_modulus,
+                                  track.slab_width, track.slab_thickness,
+                                  track.concrete_density, fill_mass))
+    base_ids = add_line(st.x_slab, 0.0, st.z_base, st.per_unit)
+    sections.append(_rect_section(conn[-1].shape[0], track.base_young_modulus,
+                                  track.base_width, track.base_thickness,
+                                  track.concrete_density, fill_mass))
+    section = BeamSection(*(np.concatenate([getattr(sec, f) for sec in sections])
+                            for f in ('ea', 'gj', 'ei_y', 'ei_z', 'mass', 'inertia_x')))
+    return _Beams(np.concatenate(coords), np.concatenate(conn), section,
+                  (rail_ids[0], rail_ids[1], slab_ids, base_ids), tuple(conn), tuple(sections))
+
+
+def _line(beams: _Beams, first_node: int, pairs: np.ndarray, y: float, z: float,
+          sec: BeamSection | None = None) -> BeamLine:
+    """Return the beam line of the elements ``pairs`` (global node numbers)."""
+    start = beams.coords[pairs[:, 0] - first_node, 0]
+    length = beams.coords[pairs[:, 1] - first_node, 0] - start
+    dofs = (pairs[:, :, None] * NODE_DOFS + np.arange(NODE_DOFS)).reshape(-1, 12)
+    return BeamLine(start, length, dofs, z, y, sec)
+
+
+def _fasteners(track: TrackParameters, st: _Stations, beams: _Beams,
+               n_units: int) -> LinkSet:
+    """Return the fasteners: rail foot on the slab top, one per rail and fastener position."""
+    n_f, n_e = track.fasteners_per_slab, track.rail_elements_per_bay
+    fast_rail_node = np.arange(st.x_fast.size) * n_e
+    fast_slab_node = (np.arange(n_units)[:, None] * st.per_unit + 1 + np.arange(n_f)).ravel()
+    dofs_f, kin_f = [], []
+    for r, side in enumerate((1.0, -1.0)):
+        a = beams.ids[r][fast_rail_node]
+        b = beams.ids[2][fast_slab_node]
+        arm_a = np.array([0.0, 0.0, -0.5 * track.rail_height])
+        arm_b = np.array([0.0, side * track.rail_semi_spacing, 0.5 * track.slab_thickness])
+        dofs_f.append(np.concatenate([node_dof_rows(a), node_dof_rows(b)], axis=1))
+        kin_f.append(np.broadcast_to(node_link(arm_a, arm_b), (a.size, 4, 12)))
+    n_fast = 2 * st.x_fast.size
+    kf = np.tile([track.fastener_longitudinal_stiffness, track.fastener_lateral_stiffness,
+                  track.fastener_vertical_stiffness,
+                  track.fastener_vertical_stiffness * track.rail_foot_width**2 / 12.0],
+                 (n_fast, 1))
+    cf = np.tile([track.fastener_lateral_damping, track.fastener_lateral_damping,
+                  track.fastener_vertical_damping, 0.0], (n_fast, 1))
+    return LinkSet(np.concatenate(dofs_f), np.concatenate(kin_f), kf, cf)
+
+
 def build_track(track: TrackParameters, bridge_length: float, train_length: float,
                 first_node: int, girder: BeamLine) -> TrackMesh:
     """
@@ -351,156 +387,26 @@ def build_track(track: TrackParameters, bridge_length: float, train_length: floa
 
     """
     extent = track_extent(track, bridge_length, train_length)
-    s, n_f = track.fastener_spacing, track.fasteners_per_slab
-    pitch = n_f * s
-    margin = 0.5 * (s - track.slab_gap)
     x0, n_units = extent.unit_start, extent.n_units
-    x1 = x0 + n_units * pitch
-
-    # Heights of the layer stack.
-    h_g = track.girder_top_height
-    z_base = h_g + 0.5 * track.base_thickness
-    z_slab = h_g + track.base_thickness + track.filling_thickness + 0.5 * track.slab_thickness
-    z_rail = z_slab + 0.5 * track.slab_thickness + 0.5 * track.rail_height
-
-    # Fasteners and rail nodes (rails run from the first to the last fastener).
-    unit0 = x0 + np.arange(n_units) * pitch
-    x_fast = (unit0[:, None] + margin + np.arange(n_f)[None, :] * s).ravel()
-    n_e = track.rail_elements_per_bay
-    h = s / n_e
-    n_rail_nodes = (x_fast.size - 1) * n_e + 1
-    x_rail = x_fast[0] + np.arange(n_rail_nodes) * h
-
-    # Slab / base nodes per unit: unit start, the fasteners, unit end.
-    unit_len = pitch - track.slab_gap
-    x_unit = np.concatenate([np.zeros((n_units, 1)),
-                             margin + np.arange(n_f)[None, :] * s * np.ones((n_units, 1)),
-                             np.full((n_units, 1), unit_len)], axis=1) + unit0[:, None]
-    per_unit = n_f + 2
-    x_slab = x_unit.ravel()
-
-    coords, conn, sections = [], [], []
-    node = first_node
-
-    def add_line(x: np.ndarray, y: float, z: float, breaks: int | None) -> np.ndarray:
-        nonlocal node
-        ids = node + np.arange(x.size)
-        coords.append(np.column_stack([x, np.full(x.size, y), np.full(x.size, z)]))
-        pairs = np.column_stack([ids[:-1], ids[1:]])
-        if breaks:
-            keep = (np.arange(x.size - 1) % breaks) != breaks - 1
-            pairs = pairs[keep]
-        conn.append(pairs)
-        node += x.size
-        return ids
-
-    e_r = track.rail_young_modulus
-    rail_ids = []
-    for side in (1.0, -1.0):
-        ids = add_line(x_rail, side * track.rail_semi_spacing, z_rail, None)
-        n = ids.size - 1
-        sections.append(BeamSection(
-            np.full(n, e_r * track.rail_mass / STEEL_DENSITY),
-            np.full(n, track.rail_torsional_stiffness),
-            np.full(n, e_r * track.rail_inertia_y), np.full(n, e_r * track.rail_inertia_z),
-            np.full(n, track.rail_mass),
-            np.full(n, STEEL_DENSITY * track.rail_polar_inertia)))
-        rail_ids.append(ids)
-    fill_mass = 0.5 * track.concrete_density * track.slab_width * track.filling_thickness
-    slab_ids = add_line(x_slab, 0.0, z_slab, per_unit)
-    sections.append(_rect_section(conn[-1].shape[0], track.slab_young_modulus,
-                                  track.slab_width, track.slab_thickness,
-                                  track.concrete_density, fill_mass))
-    base_ids = add_line(x_slab, 0.0, z_base, per_unit)
-    sections.append(_rect_section(conn[-1].shape[0], track.base_young_modulus,
-                                  track.base_width, track.base_thickness,
-                                  track.concrete_density, fill_mass))
-    coords_all = np.concatenate(coords)
-    elements = np.concatenate(conn)
-    section = BeamSection(*(np.concatenate([getattr(sec, f) for sec in sections])
-                            for f in ('ea', 'gj', 'ei_y', 'ei_z', 'mass', 'inertia_x')))
-
-    def line(ids: np.ndarray, pairs: np.ndarray, y: float, z: float,
-             sec: BeamSection | None = None) -> BeamLine:
-        start = coords_all[pairs[:, 0] - first_node, 0]
-        length = coords_all[pairs[:, 1] - first_node, 0] - start
-        dofs = (pairs[:, :, None] * NODE_DOFS + np.arange(NODE_DOFS)).reshape(-1, 12)
-        return BeamLine(start, length, dofs, z, y, sec)
-
-    rails = (line(rail_ids[0], conn[0], track.rail_semi_spacing, z_rail, sections[0]),
-             line(rail_ids[1], conn[1], -track.rail_semi_spacing, z_rail, sections[1]))
-    slab = line(slab_ids, conn[2], 0.0, z_slab)
-    base = line(base_ids, conn[3], 0.0, z_base)
-
-    # Fasteners: rail foot on the slab top, one per rail and fastener position.
-    fast_rail_node = np.arange(x_fast.size) * n_e
-    fast_slab_node = (np.arange(n_units)[:, None] * per_unit + 1 + np.arange(n_f)).ravel()
-    dofs_f, kin_f = [], []
-    for r, side in enumerate((1.0, -1.0)):
-        a = rail_ids[r][fast_rail_node]
-        b = slab_ids[fast_slab_node]
-        arm_a = np.array([0.0, 0.0, -0.5 * track.rail_height])
-        arm_b = np.array([0.0, side * track.rail_semi_spacing, 0.5 * track.slab_thickness])
-        dofs_f.append(np.concatenate([_node_dofs(a), _node_dofs(b)], axis=1))
-        kin_f.append(np.broadcast_to(_node_link(arm_a, arm_b), (a.size, 4, 12)))
-    n_fast = 2 * x_fast.size
-    kf = np.tile([track.fastener_longitudinal_stiffness, track.fastener_lateral_stiffness,
-                  track.fastener_vertical_stiffness,
-                  track.fastener_vertical_stiffness * track.rail_foot_width**2 / 12.0],
-                 (n_fast, 1))
-    cf = np.tile([track.fastener_lateral_damping, track.fastener_lateral_damping,
-                  track.fastener_vertical_damping, 0.0], (n_fast, 1))
-
+    x1 = x0 + n_units * (track.fasteners_per_slab * track.fastener_spacing)
+    st = _stations(track, extent)
+    beams = _track_beams(track, st, first_node)
+    rails = (_line(beams, first_node, beams.pairs[0], track.rail_semi_spacing, st.z_rail,
+                   beams.sections[0]),
+             _line(beams, first_node, beams.pairs[1], -track.rail_semi_spacing, st.z_rail,
+                   beams.sections[1]))
+    slab = _line(beams, first_node, beams.pairs[2], 0.0, st.z_slab)
+    base = _line(beams, first_node, beams.pairs[3], 0.0, st.z_base)
     # Continuous layers, integrated by Gauss quadrature over the upper beam's elements.
     k_l, c_l = track.layer_stiffness, track.layer_damping
-    slab_base = _layer(slab, np.array([0.0, 0.0, -0.5 * track.slab_thickness]),
-                       base, np.array([0.0, 0.0, 0.5 * track.base_thickness]),
-                       k_l, c_l, track.slab_width)
-    base_girder = _layer(base, np.array([0.0, 0.0, -0.5 * track.base_thickness]),
-                         girder, np.array([0.0, 0.0, h_g]), k_l, c_l, track.base_width)
-    fasteners = LinkSet(np.concatenate(dofs_f), np.concatenate(kin_f), kf, cf)
-    return TrackMesh(coords=coords_all, elements=elements, sections=section, rails=rails,
-                     slab=slab, base=base, links=(fasteners, slab_base, base_girder),
-                     x_start=x0, x_end=x1,
-                     rail_head=0.5 * track.rail_height, n_fasteners=int(x_fast.size))
-
-
-def _node_dofs(nodes: np.ndarray) -> np.ndarray:
-    return nodes[:, None] * NODE_DOFS + np.arange(NODE_DOFS)
-
-
-def _node_link(arm_a: np.ndarray, arm_b: np.ndarray) -> np.ndarray:
-    """Return (4, 12) rows of the relative motion and roll of two nodes' arm tips."""
-    roll = np.zeros((1, 12))
-    roll[0, 3], roll[0, 9] = 1.0, -1.0
-    return np.concatenate([link_kinematics(arm_a, arm_b)[0], roll])
-
-
-def _layer(upper: BeamLine, arm: np.ndarray, lower: BeamLine, lower_arm: np.ndarray,
-           stiffness: float, damping: float, width: float) -> LinkSet:
-    """
-    Integrate a continuous spring-dashpot layer under every element of ``upper``.
-
-    The layer resists relative x, y, z motion with ``stiffness`` per metre of
-    track (x assumed equal to y) and relative roll with stiffness * width^2 / 12
-    (vertical springs spread over the width). Where ``lower`` has no element
-    (beyond its ends, in its gaps), the layer rests on rigid ground.
-
-    Returns
-    -------
-    LinkSet
-        One link per quadrature point, over 24 DOFs (upper element, lower).
-
-    """
-    n_el = upper.start.size
-    xi = np.tile(0.5 * (_GX + 1.0), n_el)
-    element = np.repeat(np.arange(n_el), GAUSS_POINTS)
-    weight = np.tile(0.5 * _GW, n_el) * upper.length[element]
-    x = upper.start[element] + xi * upper.length[element]
-    dofs_a, rows_a, _ = upper.link_rows(x, arm)
-    dofs_b, rows_b, on = lower.link_rows(x, lower_arm)
-    dofs = np.concatenate([dofs_a, np.where(on[:, None], dofs_b, -1)], axis=1)
-    kin = np.concatenate([rows_a, -rows_b], axis=2)
-    per_length = np.array([1.0, 1.0, 1.0, width**2 / 12.0])
-    return LinkSet(dofs, kin, weight[:, None] * stiffness * per_length,
-                   weight[:, None] * damping * per_length)
+    slab_base = layer(slab, np.array([0.0, 0.0, -0.5 * track.slab_thickness]),
+                      base, np.array([0.0, 0.0, 0.5 * track.base_thickness]),
+                      k_l, c_l, track.slab_width)
+    base_girder = layer(base, np.array([0.0, 0.0, -0.5 * track.base_thickness]),
+                        girder, np.array([0.0, 0.0, track.girder_top_height]), k_l, c_l,
+                        track.base_width)
+    fasteners = _fasteners(track, st, beams, n_units)
+    return TrackMesh(coords=beams.coords, elements=beams.elements, sections=beams.section,
+                     rails=rails, slab=slab, base=base,
+                     links=(fasteners, slab_base, base_girder), x_start=x0, x_end=x1,
+                     rail_head=0.5 * track.rail_height, n_fasteners=int(st.x_fast.size))

@@ -30,10 +30,10 @@ import numpy as np
 from ttb_sim.config import car_layout, Scenario
 from ttb_sim.errors import ScenarioError
 from ttb_sim.inputs import shown
-from ttb_sim.model.bridge import (assemble_structure, pier_section, rayleigh_coefficients,
-                                  span_frequency, Structure)
+from ttb_sim.model.bridge import pier_section, rayleigh_coefficients, span_frequency
 from ttb_sim.model.foundation.operator import FoundationOperator
 from ttb_sim.model.irregularity import load_csv, synthesize, TrackIrregularity
+from ttb_sim.model.structure import assemble_structure, Structure
 from ttb_sim.model.vehicle.train import Axles, MovingForces, MultibodyCars, QuarterCars, Vehicle
 from ttb_sim.sim.coupling import (Coupling, MovingForceCoupling, QuarterCarTrain,
                                   ReducedTrainTrackCoupling, TrainTrackCoupling)

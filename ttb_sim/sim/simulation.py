@@ -29,7 +29,7 @@ import numpy as np
 
 from ttb_sim.config import Scenario
 from ttb_sim.errors import DivergenceError, ModelError, ScenarioError
-from ttb_sim.model.bridge import bearing_forces
+from ttb_sim.model.bearings import bearing_forces
 from ttb_sim.model.constants import GRAVITY
 from ttb_sim.model.vehicle.train import MultibodyCars
 from ttb_sim.sim.build import (build_coupling, build_structure, build_vehicle, observer_rows,

@@ -24,10 +24,11 @@ from typing import Any
 import numpy as np
 import pytest
 
+from ttb_sim.model.foundation.consistency import check_substructure
 from ttb_sim.model.foundation.desai import DesaiLaw, initial_moduli
-from ttb_sim.model.foundation.records import (BlockSize, check_substructure, FoundationError,
-                                              MeshSize, Observation, PAPER_LAYERS, PileGroup,
-                                              PileLoad, SoilLayer, SoilParameters, Substructure)
+from ttb_sim.model.foundation.records import (BlockSize, FoundationError, MeshSize, Observation,
+                                              PAPER_LAYERS, PileGroup, PileLoad, SoilLayer,
+                                              SoilParameters, Substructure)
 from ttb_sim.model.foundation.substructure import build
 from ttb_sim.validation.cases.pile_soil import desai_monotonic
 

@@ -33,10 +33,13 @@ import scipy.sparse.linalg as spla
 
 from ttb_sim.fe.beam import BeamSection
 from ttb_sim.model.foundation import reduction as red
+from ttb_sim.model.foundation.krylov import reduction_basis
+from ttb_sim.model.foundation.operator_cache import cache_key
 from ttb_sim.model.foundation.records import (BlockSize, Cap, FoundationError, MeshSize,
                                               Observation, PileGroup, ReductionParameters,
                                               SoilLayer, SoilParameters, Substructure)
 from ttb_sim.model.foundation.substructure import build
+from ttb_sim.model.foundation.tied import tie_cap
 
 LAYERS = (SoilLayer(2.0, 4e6, 0.35, 1835.0, 20e3, 5.0),
           SoilLayer(8.0, 6e6, 0.25, 1529.0, 10e3, 30.0))
@@ -209,8 +212,8 @@ def test_pile_heads_under_a_pier_top_pulse_match_the_unreduced_newmark(full, lar
 
 def test_interface_rows_follow_the_desai_law(large):
     """Rows = the Desai law's stress at small strain (1e-6); mobilisation scales with q."""
-    tied = red.tie_cap(build(_spec()))
-    psi, v = red.reduction_basis(tied, LARGE)
+    tied = tie_cap(build(_spec()))
+    psi, v = reduction_basis(tied, LARGE)
     phi = np.hstack([psi, np.vstack([np.zeros((6, v.shape[1])), v])])
     rng = np.random.default_rng(3)
     q = np.zeros(large.size)
@@ -234,7 +237,7 @@ def test_interface_rows_follow_the_desai_law(large):
 
 def test_cache_gives_the_same_bits_and_survives_corruption(tmp_path, monkeypatch, caplog, large):
     monkeypatch.setenv('TTB_SIM_CACHE', str(tmp_path / 'cache'))
-    caplog.set_level(logging.INFO, logger='ttb_sim.model.foundation.reduction')
+    caplog.set_level(logging.INFO, logger='ttb_sim.model.foundation')
     first = _operator()
     files = list((tmp_path / 'cache').glob('pile_soil_*.npz'))
     assert len(files) == 1 and 'cached in' in caplog.text
@@ -246,8 +249,8 @@ def test_cache_gives_the_same_bits_and_survives_corruption(tmp_path, monkeypatch
             assert np.array_equal(getattr(op, name), getattr(large, name))
         assert np.array_equal(op.interface.shear, large.interface.shear)
         assert op.soil_point_names == large.soil_point_names and op.summary == large.summary
-    assert red.cache_key(_spec(), HEIGHT, ELEMENTS, SECTION, RAYLEIGH, LARGE) != \
-        red.cache_key(_spec(), HEIGHT, ELEMENTS, SECTION, (0.1, 2e-3), LARGE)
+    assert cache_key(_spec(), HEIGHT, ELEMENTS, SECTION, RAYLEIGH, LARGE) != \
+        cache_key(_spec(), HEIGHT, ELEMENTS, SECTION, (0.1, 2e-3), LARGE)
     files[0].write_bytes(b'not an npz file')
     caplog.clear()
     third = _operator()

@@ -30,7 +30,7 @@ import pytest
 from scipy import integrate
 
 from ttb_sim.errors import ModelError
-from ttb_sim.model.irregularity import spectra
+from ttb_sim.model.irregularity import spectra, spectrum_records
 
 TWO_PI = 2.0 * math.pi
 HALF_SPACING = 0.75          # b (m), PHYSICS.md 1.3
@@ -111,7 +111,7 @@ def test_registry_names_and_components():
     assert set(spectra.SPECTRA) == expected
     assert tuple(spectra.get_spectrum('sato').components) == ('vertical',)
     for name in expected - {'sato'}:
-        assert tuple(spectra.get_spectrum(name).components) == spectra.COMPONENTS
+        assert tuple(spectra.get_spectrum(name).components) == spectrum_records.COMPONENTS
     assert len(ALL_COMPONENTS) == 37
     with pytest.raises(ModelError, match='unknown irregularity spectrum .*chinese_hsr'):
         spectra.get_spectrum('chinese')

@@ -30,7 +30,7 @@ import pytest
 from scipy import signal
 
 from ttb_sim.errors import ModelError
-from ttb_sim.model.irregularity import spectra, synthesis
+from ttb_sim.model.irregularity import spectra, spectrum_records, synthesis
 
 ALL_COMPONENTS = [(f, c) for f, fam in spectra.SPECTRA.items() for c in fam.components]
 
@@ -184,7 +184,7 @@ def test_same_seed_is_bit_identical_and_other_seed_differs():
         assert getattr(a, name).tobytes() == getattr(b, name).tobytes()
         assert not np.any(getattr(a, name) == getattr(c, name))
     # The four components have independent streams: weakly correlated.
-    corr = np.corrcoef([a.geometry(comp) for comp in spectra.COMPONENTS])
+    corr = np.corrcoef([a.geometry(comp) for comp in spectrum_records.COMPONENTS])
     assert np.max(np.abs(corr - np.eye(4))) < 0.5
 
 

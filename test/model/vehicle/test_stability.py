@@ -31,21 +31,22 @@ import numpy as np
 import pytest
 import scipy.linalg
 
+from ttb_sim.model.vehicle import linear_contact as lc
 from ttb_sim.model.vehicle import stability as st
 from ttb_sim.model.vehicle.car import CarParameters
 from ttb_sim.model.vehicle.dofs import N_DOF, wheelset_dofs
 from ttb_sim.model.vehicle.matrices import contact_map
 import ttb_sim.model.wheel_rail as ct
-from ttb_sim.model.wheel_rail.profiles import contact_geometry_table
+from ttb_sim.model.wheel_rail.contact_table import contact_geometry_table
 
 KMH = 1.0 / 3.6
 CONICITY = 0.076
 
 
 @pytest.fixture(scope='module')
-def table_geometry() -> st.LinearGeometry:
+def table_geometry() -> lc.LinearGeometry:
     """Return the LMA/CHN60 table linearised at y = 0 (equivalent conicity 0.076)."""
-    return st.table_geometry()
+    return lc.table_geometry()
 
 
 def klingel_frequency(speed: float, conicity: float, r0: float, b: float) -> float:
@@ -65,7 +66,7 @@ def test_free_wheelset_klingel_frequency_within_2_percent(speed: float) -> None:
     unstable at every speed is checked too: damping ratio < 0.
     """
     p = CarParameters()
-    geo = st.conicity_geometry(CONICITY, p.wheel_radius, contact_angle=0.0, knife_edge=False)
+    geo = lc.conicity_geometry(CONICITY, p.wheel_radius, contact_angle=0.0, knife_edge=False)
     mode = st.least_damped_mode(p, speed, geo, suspension=False, dofs=wheelset_dofs(0))
     expected = klingel_frequency(speed, CONICITY, p.wheel_radius, p.contact_semi_distance)
     assert mode.frequency == pytest.approx(expected, rel=0.02)
@@ -84,13 +85,13 @@ def test_knife_edge_roll_lowers_kinematic_frequency_by_closed_form() -> None:
     """
     p = CarParameters()
     r0, b, speed = p.wheel_radius, p.contact_semi_distance, 2.0
-    geo = st.conicity_geometry(CONICITY, r0, contact_angle=0.0, knife_edge=True)
+    geo = lc.conicity_geometry(CONICITY, r0, contact_angle=0.0, knife_edge=True)
     mode = st.least_damped_mode(p, speed, geo, suspension=False, dofs=wheelset_dofs(0))
     expected = klingel_frequency(speed, CONICITY, r0, b) / math.sqrt(1.0 + r0 * CONICITY / b)
     assert mode.frequency == pytest.approx(expected, rel=1e-3)
 
 
-def test_table_geometry_matches_equivalent_conicity(table_geometry: st.LinearGeometry) -> None:
+def test_table_geometry_matches_equivalent_conicity(table_geometry: lc.LinearGeometry) -> None:
     """The table's radius slope is its equivalent conicity at 1 mm (0.0759), within 1e-3."""
     tb = contact_geometry_table()
     assert table_geometry.radius_slope[0] == pytest.approx(tb.equivalent_conicity(1e-3),
@@ -138,13 +139,13 @@ def test_contact_matrices_match_central_differences_of_the_contact_laws() -> Non
 
     Steps 1e-6 m (rad) in q and 1e-4 m/s in q' (the laws are affine in q'
     and the table is piecewise linear with 0.1 mm cells, so the secant of
-    :func:`st.table_geometry` with a 0.1 mm step is the exact derivative).
+    :func:`lc.table_geometry` with a 0.1 mm step is the exact derivative).
     The only remaining difference is xi_x's r_s vs r0 on the spin rate (5e-6).
     """
     p = CarParameters()
     speed = 300.0 * KMH
-    geo = st.table_geometry(step=1e-4)
-    c_c, k_c = st.contact_matrices(p, speed, geo)
+    geo = lc.table_geometry(step=1e-4)
+    c_c, k_c = lc.contact_matrices(p, speed, geo)
     zero = np.zeros(N_DOF)
     k_num = np.zeros((N_DOF, N_DOF))
     c_num = np.zeros((N_DOF, N_DOF))
@@ -164,7 +165,7 @@ def test_contact_matrices_match_central_differences_of_the_contact_laws() -> Non
         np.abs(k_c[np.ix_(lat, lat)]))
 
 
-def test_rigid_body_roots_are_removed_exactly(table_geometry: st.LinearGeometry) -> None:
+def test_rigid_body_roots_are_removed_exactly(table_geometry: lc.LinearGeometry) -> None:
     """
     The reduced spectrum is the full spectrum minus six roots at zero.
 
@@ -210,7 +211,7 @@ DAMPER_COUNTS = {
 @pytest.mark.parametrize('counts, expected_kmh', [('car_defaults', 272.1),
                                                   ('scenario_defaults', 270.8)])
 def test_car_without_yaw_dampers_hunts_between_200_and_300_kmh(
-        table_geometry: st.LinearGeometry, counts: str, expected_kmh: float) -> None:
+        table_geometry: lc.LinearGeometry, counts: str, expected_kmh: float) -> None:
     """
     The Table 1 car without anti-yaw dampers: critical speed 272.1 / 270.8 km/h (measured).
 
@@ -233,7 +234,7 @@ def test_car_without_yaw_dampers_hunts_between_200_and_300_kmh(
 @pytest.mark.parametrize('counts, expected_kmh', [('car_defaults', 542.5),
                                                   ('scenario_defaults', 534.2)])
 def test_default_yaw_dampers_stable_at_300_and_350_kmh(
-        table_geometry: st.LinearGeometry, counts: str, expected_kmh: float) -> None:
+        table_geometry: lc.LinearGeometry, counts: str, expected_kmh: float) -> None:
     """
     With 4 x 250 kN s/m anti-yaw dampers: stable at 300 and 350 km/h; critical 542.5 / 534.2 km/h.
 
@@ -249,7 +250,7 @@ def test_default_yaw_dampers_stable_at_300_and_350_kmh(
 
 
 def test_critical_speed_refuses_a_bracket_that_starts_unstable(
-        table_geometry: st.LinearGeometry) -> None:
+        table_geometry: lc.LinearGeometry) -> None:
     """A scan starting above the critical speed is refused, stable ranges give inf."""
     from ttb_sim.errors import ModelError
     p = CarParameters(yaw_dampers=0)

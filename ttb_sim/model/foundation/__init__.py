@@ -12,4 +12,13 @@
 # See the License for the specific language governing permissions and
 # limitations under the License.
 
-"""Piled foundations in soil: records, the Desai interface law, the 3-D substructure."""
+"""
+The piers' foundations: springs or piled, and the 3-D pile-soil substructure of a piled pier.
+
+:mod:`.pier_foundations` (the foundation record, springs, piled piers in the structure),
+:mod:`.records` and :mod:`.consistency` (soil, piles, cap, interface, load, and their
+cross-checks), :mod:`.desai` (the interface law), :mod:`.soil_mesh`, :mod:`.substructure`
+and :mod:`.observation` (the finite-element substructure), :mod:`.operator` (what the
+bridge sees of it), :mod:`.tied`, :mod:`.krylov`, :mod:`.reduction` and
+:mod:`.operator_cache` (its reduced operator and the cache of it).
+"""

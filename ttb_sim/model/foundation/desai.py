@@ -53,6 +53,8 @@ from typing import Literal
 
 import numpy as np
 
+from ttb_sim.errors import ModelError
+
 ShearModulus = Literal['G', 'lame']
 
 
@@ -72,7 +74,7 @@ def initial_moduli(young: np.ndarray, poisson: np.ndarray,
     elif shear_modulus == 'lame':
         k_s0 = e * nu / ((1 + nu) * (1 - 2 * nu))
     else:
-        raise ValueError(f"shear_modulus must be 'G' or 'lame', not {shear_modulus!r}")
+        raise ModelError(f"shear_modulus must be 'G' or 'lame', not {shear_modulus!r}")
     return k_n0, k_s0
 
 

@@ -16,13 +16,13 @@
 Records describing a pier-cap-pile-soil substructure and its load (SI units).
 
 Frozen dataclasses whose user-settable fields are declared once with
-:func:`~ttb_sim.parameters.param` (default, unit, range, description): the
+:func:`~ttb_sim.declarations.param` (default, unit, range, description): the
 scenario sections ``soil``, ``piles``, ``cap``, ``interface`` and ``load`` are
 these records, so every field is a scenario key. A bad value raises
 :class:`FoundationError` naming the key, the value and what is allowed.
 Checks that involve several records (piles inside the block, pile shorter
 than the deposit, mesh fine enough for the load) are in
-:func:`check_substructure`.
+:func:`~.consistency.check_substructure`.
 
 Geometry: x along the track, y to the left, z up; the ground surface is
 z = 0 and the plan origin is the centre of the soil block. Piles are numbered
@@ -37,9 +37,9 @@ from dataclasses import dataclass, field
 import math
 from typing import Optional
 
+from ttb_sim.declarations import check_declared, param
 from ttb_sim.errors import ModelError
 from ttb_sim.model.constants import GRAVITY
-from ttb_sim.parameters import check_declared, param
 
 #: Side of the square of equal area over the diameter of a circle, sqrt(pi) / 2.
 EQUAL_AREA_SIDE = math.sqrt(math.pi) / 2.0
@@ -462,68 +462,3 @@ class Substructure:
         """The two Rayleigh reference frequencies (Hz)."""
         f1, f2 = self.soil.rayleigh_frequencies
         return float(f1), float(f2)
-
-
-def check_substructure(spec: Substructure, load: Optional[PileLoad] = None) -> None:
-    """
-    Check what the single records cannot: geometry fits and mesh carries the load.
-
-    Raises
-    ------
-    FoundationError
-        Piles outside the block or the cap, a pile as long as the deposit or
-        longer, a periodic block with piles, a load on a pile that does not
-        exist, or a mesh whose near-pile size ``h`` cannot carry the load
-        frequency (f > Vs_min / (points_per_wavelength h)).
-
-    """
-    soil, piles = spec.soil, spec.piles
-    if piles is not None:
-        if soil.periodic:
-            raise FoundationError('soil.periodic = True is for soil columns; it cannot '
-                                  'carry piles (set piles to none)')
-        if piles.length >= soil.depth:
-            message = (f'piles.length = {piles.length!r} m reaches the base of the '
-                       f'{soil.depth:g} m deposit; allowed: < {soil.depth:g} m')
-            raise FoundationError(message)
-        half = 0.5 * piles.width
-        xs = [c[0] for c in piles.centres()]
-        ys = [c[1] for c in piles.centres()]
-        margin = spec.mesh.h
-        if (min(xs) - half < -0.5 * soil.lx + margin or max(xs) + half > 0.5 * soil.lx - margin
-                or min(ys) - half < -0.5 * soil.ly + margin
-                or max(ys) + half > 0.5 * soil.ly - margin):
-            message = (f'piles extend over x [{min(xs) - half:g}, {max(xs) + half:g}] m, '
-                       f'y [{min(ys) - half:g}, {max(ys) + half:g}] m: outside the soil block '
-                       f'(soil.block.lx = {soil.lx:g}, ly = {soil.ly:g} m, centred at 0, '
-                       f'less one element of {margin:g} m)')
-            raise FoundationError(message)
-        if spec.cap.enabled:
-            if (max(abs(x) for x in xs) + half > 0.5 * spec.cap.lx + 1e-9
-                    or max(abs(y) for y in ys) + half > 0.5 * spec.cap.ly + 1e-9):
-                raise FoundationError(f'the cap ({spec.cap.lx:g} x {spec.cap.ly:g} m) does '
-                                      'not cover the pile heads')
-    top = spec.cap.thickness if spec.cap.enabled and piles is not None else 0.0
-    for i, point in enumerate(spec.observation.points):
-        x, y, z = point
-        if not (abs(x) <= 0.5 * soil.lx and abs(y) <= 0.5 * soil.ly
-                and -soil.depth <= z <= top):
-            raise FoundationError(
-                f'output.soil_points[{i}] = {list(point)!r} lies outside the soil block; '
-                f'allowed: |x| <= {0.5 * soil.lx:g}, |y| <= {0.5 * soil.ly:g}, '
-                f'{-soil.depth:g} <= z <= {top:g} m (soil.block.lx, soil.block.ly, soil.layers)')
-    if load is not None and load.type != 'none':
-        if load.target == 'pile':
-            count = piles.count if piles is not None else 0
-            if load.pile > count:
-                message = f'load.pile = {load.pile!r}; allowed: 1 .. {count} (piles in group)'
-                raise FoundationError(message)
-        if load.type != 'static':
-            carried = soil.vs_min / (spec.mesh.points_per_wavelength * spec.mesh.h)
-            largest = soil.vs_min / (spec.mesh.points_per_wavelength * load.frequency)
-            if load.frequency > carried:
-                message = (f'load.frequency = {load.frequency:g} Hz is above the '
-                           f'{carried:.3g} Hz that soil.mesh.h = {spec.mesh.h:g} m carries '
-                           f'(Vs_min / ({spec.mesh.points_per_wavelength:g} h)); '
-                           f'allowed: soil.mesh.h <= {largest:.3g} m for this load')
-                raise FoundationError(message)

@@ -22,10 +22,11 @@ The reduced-order pier-cap-pile-soil substructure of one piled pier.
    initial (geostatic) tangent, C = soil + structure + boundary damping,
    M = lumped mass, on the free DOFs.
 2. The cap top face tied rigidly to a 6-DOF master at the group centre on the
-   cap top (u_i = u_m + theta x r_i), and a pier column of beam elements
+   cap top (u_i = u_m + theta x r_i; :func:`~.tied.tie_cap`), and a pier column of beam elements
    (:func:`~.operator.pier_column`, Rayleigh C = a0 M + a1 K) standing on
    that master; the column's top node is q[:6].
-3. The reduction. The column and the master stay physical. The soil-pile-cap
+3. The reduction (:func:`~.krylov.reduction_basis`). The column and the master
+   stay physical. The soil-pile-cap
    interior is the static (constraint) modes of the master, Psi = -K_ii^-1 K_ib,
    plus a basis V of second-order block Krylov vectors of the master loads
    B: at each real shift s >= 0 the pencil Z = K + s C + s^2 M is symmetric
@@ -52,83 +53,42 @@ at the initial tangent with their Mohr-Coulomb strength, so that
 :func:`interface_mobilisation` can show a run stayed linear.
 
 The operator of a given set of inputs is cached on disk (``$TTB_SIM_CACHE``
-or ``~/.cache/ttb_sim``) under a hash of every input; the build is
-deterministic, so a cache hit gives the same bits as a fresh build. A
-corrupt or unwritable cache is logged and bypassed.
+or ``~/.cache/ttb_sim``) under a hash of every input (:mod:`.operator_cache`);
+the build is deterministic, so a cache hit gives the same bits as a fresh
+build. A corrupt or unwritable cache is logged and bypassed.
 """
 
 from __future__ import annotations
 
 import contextlib
 from dataclasses import dataclass
-import hashlib
-import json
 import logging
 import math
-import os
-from pathlib import Path
 import time
-from typing import Any, Callable, Iterator, Optional
+from typing import Any, Iterator, Optional
 
 import numpy as np
-import scipy
-import scipy.linalg as sla
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 from ttb_sim.fe.beam import BeamSection, NODE_DOFS
-from ttb_sim.fe.factorization import available, factorize, resolve
-from ttb_sim.fe.mesh import node_dofs
+from ttb_sim.fe.factorization import resolve
+from ttb_sim.model.foundation.krylov import FACTORIZATION, reduction_basis
 from ttb_sim.model.foundation.operator import (FoundationOperator, InterfaceRows,
                                                pier_column)
+from ttb_sim.model.foundation.operator_cache import (cache_directory, cache_key,
+                                                     load_operator, save_operator)
 from ttb_sim.model.foundation.records import (FoundationError, ReductionParameters,
                                               Substructure)
-from ttb_sim.model.foundation.substructure import build, CAP, PileSoilModel, planned_nodes
+from ttb_sim.model.foundation.soil_mesh import planned_nodes
+from ttb_sim.model.foundation.substructure import build
+from ttb_sim.model.foundation.tied import check_spec, tie_cap, TiedSubstructure
 
 LOG = logging.getLogger(__name__)
 
 BUILD_SECONDS_PER_DOF = 509.0 / (81_648 * 5)
 """CPU seconds per DOF and shift of a reduction, measured on the paper mesh (81 648 DOFs, five
 shifts, 509 s on this 2-core machine): the order of magnitude the first-build notice gives."""
-
-FORMAT = 2
-"""Version of the reduction and of its cache files; part of the cache key."""
-FACTORIZATION = 'cholmod'
-"""Factorisation of the shifted pencils (falls back as :func:`factorize` says)."""
-
-
-@dataclass(frozen=True)
-class TiedSubstructure:
-    """
-    The linear pile-soil model with the cap top tied to a 6-DOF master (sparse).
-
-    Coordinates x = [master (ux, uy, uz, rx, ry, rz), free DOFs not on the cap
-    top]; the full displacement is u = ``transform`` @ x.
-
-    Attributes
-    ----------
-    model : PileSoilModel
-        The finite-element substructure.
-    transform : csr (n_dofs, n_x)
-        u = T x.
-    mass, damping, stiffness : csr (n_x, n_x)
-        T^T M T, T^T C T, T^T K T (K with the interface at its initial tangent).
-    master : array (3,)
-        Master position: the group centre on the cap top (m).
-
-    """
-
-    model: PileSoilModel
-    transform: sp.csr_matrix
-    mass: sp.csr_matrix
-    damping: sp.csr_matrix
-    stiffness: sp.csr_matrix
-    master: np.ndarray
-
-    @property
-    def size(self) -> int:
-        """Number of coordinates n_x."""
-        return int(self.transform.shape[1])
 
 
 @dataclass(frozen=True)
@@ -147,66 +107,6 @@ class SparseOperator:
     stiffness: sp.csr_matrix
     pile_heads: sp.csr_matrix
     soil_points: sp.csr_matrix
-
-
-def check_spec(spec: Substructure) -> None:
-    """
-    Refuse a substructure that cannot carry a reduced pier.
-
-    Raises
-    ------
-    FoundationError
-        No piles, the cap disabled, or a boundary without static support.
-
-    """
-    if spec.piles is None:
-        raise FoundationError('piles = none: a piled pier needs piles (set piles.rows and '
-                              'piles.cols)')
-    if not spec.cap.enabled:
-        raise FoundationError('cap.enabled = False: the pier stands on the cap top; allowed '
-                              'for a piled pier: cap.enabled = true')
-    if spec.soil.boundary == 'lysmer':
-        raise FoundationError("soil.boundary = 'lysmer' leaves the block without static "
-                              "support; allowed for a piled pier: 'viscoelastic' or 'fixed'")
-
-
-def tie_cap(model: PileSoilModel) -> TiedSubstructure:
-    """Return the linear model with the cap top tied rigidly to a master at its centre."""
-    spec = model.spec
-    check_spec(spec)
-    assert spec.piles is not None
-    nodes = model.mesh.nodes
-    top = spec.cap.thickness
-    cap_nodes = np.unique(model.mesh.cells[model.cell_kind == CAP])
-    tied = cap_nodes[np.abs(nodes[cap_nodes, 2] - top) <= 1e-9 * max(1.0, top)]
-    master = np.array([spec.piles.centre[0], spec.piles.centre[1], top], dtype=float)
-    n_dofs = model.n_dofs
-    on_top = np.zeros(n_dofs, dtype=bool)
-    on_top[node_dofs(tied[:, None]).ravel()] = True
-    kept = np.flatnonzero(model.free & ~on_top)
-    r = nodes[tied] - master
-    one = np.ones(len(tied))
-    # u = u_m + theta x r: (theta_y r_z - theta_z r_y, theta_z r_x - theta_x r_z,
-    # theta_x r_y - theta_y r_x)
-    terms = [(0, 0, one), (0, 4, r[:, 2]), (0, 5, -r[:, 1]),
-             (1, 1, one), (1, 5, r[:, 0]), (1, 3, -r[:, 2]),
-             (2, 2, one), (2, 3, r[:, 1]), (2, 4, -r[:, 0])]
-    rows = [kept] + [3 * tied + axis for axis, _, _ in terms]
-    cols = [6 + np.arange(len(kept))] + [np.full(len(tied), c) for _, c, _ in terms]
-    vals = [np.ones(len(kept))] + [v for _, _, v in terms]
-    transform = sp.csr_matrix((np.concatenate(vals), (np.concatenate(rows),
-                                                      np.concatenate(cols))),
-                              shape=(n_dofs, 6 + len(kept)))
-    k = model.linear_stiffness() + model.initial_interface_stiffness()
-    c = model.linear_damping()
-    m = sp.diags(model.mass)
-    t_t = transform.T.tocsr()
-
-    def project(a: sp.spmatrix) -> sp.csr_matrix:
-        out = (t_t @ a @ transform).tocsr()
-        return ((out + out.T) * 0.5).tocsr()
-
-    return TiedSubstructure(model, transform, project(m), project(c), project(k), master)
 
 
 def pile_soil_operator(spec: Substructure, pier_height: float, pier_elements: int,
@@ -248,12 +148,12 @@ def pile_soil_operator(spec: Substructure, pier_height: float, pier_elements: in
     """
     check_spec(spec)
     if len(pier_section.ea) != pier_elements:
-        raise ValueError(f'pier_section has {len(pier_section.ea)} elements, pier_elements '
-                         f'= {pier_elements}')
+        raise FoundationError(f'pier_section has {len(pier_section.ea)} elements, pier_elements '
+                              f'= {pier_elements}')
     key = cache_key(spec, pier_height, pier_elements, pier_section, pier_rayleigh, reduction)
     path = cache_directory() / f'pile_soil_{key[:32]}.npz' if cache else None
     if path is not None and path.exists():
-        op = _load(path)
+        op = load_operator(path)
         if op is not None:
             LOG.info('reduced pile-soil substructure read from the cache %s', path)
             return op
@@ -270,7 +170,7 @@ def pile_soil_operator(spec: Substructure, pier_height: float, pier_elements: in
     LOG.info('reduced pile-soil substructure: %d full DOFs -> %d coordinates in %.1f s of CPU',
              op.summary['full_dofs'], op.size, time.process_time() - start)
     if path is not None:
-        _save(path, op)
+        save_operator(path, op)
     return op
 
 
@@ -311,130 +211,6 @@ def _build(spec: Substructure, pier_height: float, pier_elements: int,
                               depth=float(pier_height + spec.cap.thickness), summary=summary,
                               interface=_interface_rows(tied, phi, lead),
                               pile_rotations=rotations)
-
-
-def reduction_basis(tied: TiedSubstructure, reduction: ReductionParameters
-                    ) -> tuple[np.ndarray, np.ndarray]:
-    """
-    Return the static modes Psi (n_x, 6) and the interior Krylov basis V (n_x - 6, r).
-
-    Psi has the identity on the master and the static interior response
-    -K_ii^-1 K_ib below it; V is mass-orthonormal (V^T M_ii V = I) and zero
-    on the master. See the module docstring.
-    """
-    k, c, m = tied.stiffness, tied.damping, tied.mass
-    n = tied.size
-    weight = m.diagonal()
-    b = np.zeros((n, 6))
-    b[:6] = np.eye(6)
-    static = factorize(k, method=FACTORIZATION)
-    x0 = static.solve(b)
-    psi = np.empty((n, 6))
-    psi[:6] = np.eye(6)
-    psi[6:] = np.linalg.solve(x0[:6].T, x0[6:].T).T
-    del x0
-    blocks: list[np.ndarray] = []
-    if 0.0 in reduction.shifts:
-        blocks += _soar(static.solve, c, m, weight, b, reduction.levels, reduction.tolerance)
-    del static  # one factorisation in memory at a time
-    for f in reduction.shifts:
-        w = 2 * math.pi * float(f)
-        if w == 0:
-            continue
-        if reduction.shift_axis == 'real':
-            solver = factorize(_symmetric(k + w * c + (w * w) * m), method=FACTORIZATION)
-            blocks += _soar(solver.solve, (c + 2 * w * m).tocsr(), m, weight, b,
-                            reduction.levels, reduction.tolerance)
-            del solver
-        else:
-            solve = _complex_solver(k, c, m, w)
-            found = _soar(solve, (c + 2j * w * m).tocsr(), m, weight, b.astype(complex),
-                          reduction.levels, reduction.tolerance)
-            del solve
-            blocks += [part for q in found for part in (q.real, q.imag)]
-        LOG.debug('reduction: %d Krylov blocks after the shift at %g Hz', len(blocks), f)
-    w_all = np.hstack(blocks)
-    del blocks
-    interior = w_all[6:] - psi[6:] @ w_all[:6]
-    del w_all
-    return psi, _orthonormal(interior, weight[6:], reduction.tolerance)
-
-
-def _symmetric(a: sp.spmatrix) -> sp.csr_matrix:
-    a = sp.csr_matrix(a)
-    return ((a + a.T) * 0.5).tocsr()
-
-
-def _complex_solver(k: sp.csr_matrix, c: sp.csr_matrix, m: sp.csr_matrix,
-                    w: float) -> Callable[[np.ndarray], np.ndarray]:
-    """
-    Return a solve of Z(i w) x = r, Z = K - w^2 M + i w C (complex symmetric).
-
-    Through the real symmetric indefinite form [[A, B], [B, -A]] [x_r; -x_i] =
-    [r_r; r_i] with A = K - w^2 M, B = w C, factorised by LDL^T (QDLDL, AMD
-    order; SuperLU in symmetric mode without the qdldl wheel).
-    """
-    a = _symmetric(k - (w * w) * m)
-    bb = _symmetric(w * c)
-    big = sp.bmat([[a, bb], [bb, -a]], format='csc')
-    lu = factorize(big, method='qdldl' if available('qdldl') else 'superlu_sym')
-    n = a.shape[0]
-
-    def solve(rhs: np.ndarray) -> np.ndarray:
-        x = lu.solve(np.vstack([rhs.real, rhs.imag]))
-        return x[:n] - 1j * x[n:]
-
-    return solve
-
-
-def _soar(solve: Callable[[np.ndarray], np.ndarray], d1: sp.csr_matrix, m: sp.csr_matrix,
-          weight: np.ndarray, b: np.ndarray, levels: int, tol: float) -> list[np.ndarray]:
-    """Return the blocks of the second-order Krylov sequence (weight-orthonormal)."""
-    q, p = _block(solve(b), np.zeros_like(b), [], [], weight, tol)
-    qs, ps = [q], [p]
-    for _ in range(levels - 1):
-        if qs[-1].shape[1] == 0:
-            break
-        r = solve(-(d1 @ qs[-1] + m @ ps[-1]))
-        q, p = _block(r, qs[-1].copy(), qs, ps, weight, tol)
-        qs.append(q)
-        ps.append(p)
-    return [q for q in qs if q.shape[1]]
-
-
-def _block(r: np.ndarray, s: np.ndarray, qs: list[np.ndarray], ps: list[np.ndarray],
-           weight: np.ndarray, tol: float) -> tuple[np.ndarray, np.ndarray]:
-    """Orthonormalise r against qs and within itself; apply the same to s against ps."""
-    norms = np.sqrt(np.einsum('i,ij,ij->j', weight, r.conj(), r).real)
-    for _ in range(2):
-        for qb, pb in zip(qs, ps):
-            h = qb.conj().T @ (weight[:, None] * r)
-            r -= qb @ h
-            s -= pb @ h
-    root = np.sqrt(weight)
-    qq, rr, piv = sla.qr(root[:, None] * r, mode='economic', pivoting=True)
-    d = np.abs(np.diag(rr))
-    keep = 0
-    while keep < len(d) and d[keep] > tol * max(norms[piv[keep]], 1e-300):
-        keep += 1
-    t_inv = sla.solve_triangular(rr[:keep, :keep], np.eye(keep))
-    return qq[:, :keep] / root[:, None], s[:, piv[:keep]] @ t_inv
-
-
-def _orthonormal(w: np.ndarray, weight: np.ndarray, tol: float) -> np.ndarray:
-    """
-    Return a weight-orthonormal basis of the columns of w, dropping dependent ones.
-
-    The columns come from vectors of unit weighted norm (their master part
-    removed), so a direction is kept when what is left of it outside the
-    others is above ``tol``.
-    """
-    root = np.sqrt(weight)
-    if w.shape[1] == 0:
-        return np.zeros((len(weight), 0))
-    qq, rr, _ = sla.qr(root[:, None] * w, mode='economic', pivoting=True)
-    keep = int(np.count_nonzero(np.abs(np.diag(rr)) > tol))
-    return qq[:, :keep] / root[:, None]
 
 
 def _galerkin(a: sp.csr_matrix, phi: np.ndarray) -> np.ndarray:
@@ -502,16 +278,16 @@ def interface_mobilisation(op: FoundationOperator, q_history: np.ndarray) -> flo
 
     Raises
     ------
-    ValueError
+    FoundationError
         When ``op`` has no interface rows or q has the wrong size.
 
     """
     rows = op.interface
     if rows is None:
-        raise ValueError('this foundation operator has no interface rows')
+        raise FoundationError('this foundation operator has no interface rows')
     q = np.atleast_2d(np.asarray(q_history, dtype=float))
     if q.shape[1] != op.size:
-        raise ValueError(f'q_history has {q.shape[1]} coordinates, the operator {op.size}')
+        raise FoundationError(f'q_history has {q.shape[1]} coordinates, the operator {op.size}')
     worst = 0.0
     for start in range(0, len(q), 1024):
         chunk = q[start:start + 1024]
@@ -570,78 +346,6 @@ def dynamic_flexibility(mass: Any, damping: Any, stiffness: Any, frequencies: np
             x = np.linalg.solve(z, rhs)
         out[i] = x[dofs]
     return out
-
-
-# --------------------------------------------------------------------------- cache
-
-def cache_directory() -> Path:
-    """Return the cache directory: ``$TTB_SIM_CACHE`` or ``~/.cache/ttb_sim``."""
-    env = os.environ.get('TTB_SIM_CACHE', '')
-    return Path(env) if env else Path.home() / '.cache' / 'ttb_sim'
-
-
-def cache_key(spec: Substructure, pier_height: float, pier_elements: int,
-              pier_section: BeamSection, pier_rayleigh: tuple[float, float],
-              reduction: ReductionParameters) -> str:
-    """Return the SHA-256 of every input of :func:`pile_soil_operator` (and the code)."""
-    digest = hashlib.sha256()
-    text = repr((FORMAT, resolve(FACTORIZATION), np.__version__, scipy.__version__, spec,
-                 float(pier_height), int(pier_elements),
-                 tuple(float(v) for v in pier_rayleigh), reduction))
-    digest.update(text.encode())
-    for name in ('ea', 'gj', 'ei_y', 'ei_z', 'mass', 'inertia_x'):
-        digest.update(np.ascontiguousarray(getattr(pier_section, name), dtype=float).tobytes())
-    return digest.hexdigest()
-
-
-_ARRAYS = ('mass', 'damping', 'stiffness', 'pile_heads', 'pile_positions', 'soil_points',
-           'soil_point_positions', 'pile_rotations')
-_INTERFACE = ('normal', 'shear', 'sigma_n0', 'cohesion', 'tan_delta')
-
-
-def _save(path: Path, op: FoundationOperator) -> None:
-    arrays: dict[str, Any] = {name: getattr(op, name) for name in _ARRAYS}
-    arrays['soil_point_names'] = np.array(op.soil_point_names, dtype=str)
-    arrays['depth'] = np.array(op.depth)
-    arrays['summary'] = np.array(json.dumps(op.summary))
-    if op.interface is not None:
-        arrays.update({f'interface_{n}': getattr(op.interface, n) for n in _INTERFACE})
-    tmp = path.with_name(f'.{path.name}.{os.getpid()}.tmp')
-    try:
-        path.parent.mkdir(parents=True, exist_ok=True)
-        with open(tmp, 'wb') as handle:
-            np.savez(handle, **arrays)
-        os.replace(tmp, path)
-        LOG.info('reduced pile-soil substructure cached in %s', path)
-    except OSError as err:
-        LOG.warning('could not write the cache %s (%s); continuing without it', path, err)
-        with contextlib.suppress(OSError):
-            tmp.unlink()
-
-
-def _load(path: Path) -> Optional[FoundationOperator]:
-    try:
-        with np.load(path, allow_pickle=False) as data:
-            got = {name: data[name] for name in data.files}
-        n = got['mass'].shape[0]
-        iface = None
-        if 'interface_normal' in got:
-            iface = InterfaceRows(**{name: got[f'interface_{name}'] for name in _INTERFACE})
-            if iface.normal.shape[1] != n or iface.shear.shape != (2 * iface.n_points, n):
-                raise ValueError('interface rows of the wrong shape')
-        op = FoundationOperator(**{name: got[name] for name in _ARRAYS},
-                                soil_point_names=tuple(str(s) for s in got['soil_point_names']),
-                                depth=float(got['depth']),
-                                summary=json.loads(str(got['summary'])), interface=iface)
-        square = all(getattr(op, a).shape == (n, n) for a in ('mass', 'damping', 'stiffness'))
-        if (not square or op.pile_heads.shape != (3 * op.n_piles, n)
-                or op.soil_points.shape != (3 * len(op.soil_point_names), n)):
-            raise ValueError('arrays of inconsistent shapes')
-        return op
-    except Exception as err:  # noqa: B902 - any unreadable cache file means: rebuild
-        LOG.warning('the cache file %s is unreadable (%s); rebuilding', path,
-                    f'{type(err).__name__}: {err}')
-        return None
 
 
 @contextlib.contextmanager

@@ -16,23 +16,23 @@
 The 3-D pier-cap-pile-soil substructure assembled from its records.
 
 :func:`build` turns a :class:`~.records.Substructure` into a
-:class:`PileSoilModel`: a structured brick mesh of the layered block with node
-planes at every pile face, pile tip, cap face and layer interface; soil cells
-inside the piles replaced by pile cells ([P] section 2.4); the cap as solid
-cells on the ground surface, sharing nodes with the pile heads and the soil
-surface under it; the pile-soil interface as Desai thin-layer elements between
-duplicated nodes on the pile shafts and tips, or shared nodes (``bonded``);
-the viscous-spring, dashpot or fixed boundary on the sides and base.
+:class:`PileSoilModel` in named steps: the structured brick mesh of the layered
+block with node planes at every pile face, pile tip, cap face and layer
+interface, its cells tagged soil, pile ([P] section 2.4) or cap (solid cells on
+the ground surface, sharing nodes with the pile heads and the soil surface
+under it) and the pile-soil interface's nodes duplicated on the pile shafts and
+tips, or shared (``bonded``) (:mod:`.soil_mesh`); the materials; the assembly
+of the linear operators; the viscous-spring, dashpot or fixed boundary on the
+sides and base; the Desai thin-layer interface elements; the observation rows
+(:mod:`.observation`).
 
 The model keeps the *linear* operators (lumped mass, soil and structure
 stiffness and Rayleigh damping, boundary springs and dashpots) apart from the
 interface (:class:`~ttb_sim.fe.interface.InterfaceSet` plus its
 :class:`~.desai.DesaiLaw`), so that a reduced-order model can later replace
 the linear part behind the same attributes. It also holds the observation
-operators: pile-head displacement (area-weighted mean over the head nodes, the
-work-conjugate of a uniform head pressure), pile-head rotation (weighted
-least-squares rigid fit) and soil points (trilinear interpolation in the
-containing cell).
+operators of :mod:`.observation`: pile-head displacement and rotation, ground
+surface weights and soil points.
 
 Damping: Rayleigh C = alpha M + beta K per material, with each material's
 damping ratio at the two ``rayleigh_frequencies``. Interface initial stress:
@@ -46,35 +46,28 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 import logging
 import math
-from typing import Optional
+from typing import cast, Optional
 
 import numpy as np
 import scipy.sparse as sp
 
 from ttb_sim.fe import hex8
-from ttb_sim.fe.assembly import assemble
-from ttb_sim.fe.boundary import face_matrices, viscoelastic_coefficients
+from ttb_sim.fe.assembly import assemble_chunked
+from ttb_sim.fe.boundary import boundary_matrix, Lumping, viscoelastic_coefficients
 from ttb_sim.fe.interface import interface_set, InterfaceSet
-from ttb_sim.fe.mesh import graded_planes, Grid, HEX_FACES, Mesh, node_dofs
-from ttb_sim.fe.quad import face_frames, FACE_N
+from ttb_sim.fe.mesh import FACE_NAMES, Grid, grid_cells, GridCells, HEX_FACES, Mesh, node_dofs
+from ttb_sim.fe.quad import FACE_N
 from ttb_sim.model.constants import GRAVITY
+from ttb_sim.model.foundation.consistency import check_substructure
 from ttb_sim.model.foundation.desai import DesaiLaw, initial_moduli
-from ttb_sim.model.foundation.records import (check_substructure, FoundationError, PileLoad,
-                                              Substructure)
+from ttb_sim.model.foundation.observation import (head_operators, soil_points, SoilPoints,
+                                                  surface_weights)
+from ttb_sim.model.foundation.records import PileLoad, Substructure
+from ttb_sim.model.foundation.soil_mesh import (CAP, CellTags, check_aspect, InterfaceSplit,
+                                                PILE, SOIL, soil_grid, split_interface,
+                                                tag_cells)
 
 LOG = logging.getLogger(__name__)
-
-#: Cell kinds.
-SOIL, PILE, CAP = 0, 1, 2
-
-
-@dataclass(frozen=True)
-class SoilPoints:
-    """Soil observation points: positions (p, 3) m, names, interpolation (3p x n_dofs)."""
-
-    positions: np.ndarray
-    names: tuple[str, ...]
-    operator: sp.csr_matrix
 
 
 @dataclass
@@ -192,49 +185,6 @@ def rayleigh_coefficients(damping_ratio: np.ndarray,
     return 2 * zeta * w1 * w2 / (w1 + w2), 2 * zeta / (w1 + w2)
 
 
-def _planes(spec: Substructure) -> Grid:
-    soil, piles, cap, size = spec.soil, spec.piles, spec.cap, spec.mesh
-    tops = soil.layer_tops()
-    zkeys = tops + [-soil.depth]
-    xkeys: list[float] = []
-    ykeys: list[float] = []
-    xzones: list[tuple[float, float]] = []
-    yzones: list[tuple[float, float]] = []
-    zzones: list[tuple[float, float]] = []
-    zlimits: list[tuple[float, float, float]] = []
-    top = 0.0
-    if piles is not None:
-        half = 0.5 * piles.width
-        cx = sorted({c[0] for c in piles.centres()})
-        cy = sorted({c[1] for c in piles.centres()})
-        xkeys += [x + s for x in cx for s in (-half, half)]
-        ykeys += [y + s for y in cy for s in (-half, half)]
-        pad = 1.0
-        xzones.append((cx[0] - half - pad, cx[-1] + half + pad))
-        yzones.append((cy[0] - half - pad, cy[-1] + half + pad))
-        zkeys.append(-piles.length)
-        zzones += [(0.0, 0.0), (-piles.length, -piles.length)]
-        zlimits.append((-piles.length, 0.0, size.shaft))
-        if cap.enabled:
-            xkeys += [-0.5 * cap.lx + piles.centre[0], 0.5 * cap.lx + piles.centre[0]]
-            ykeys += [-0.5 * cap.ly + piles.centre[1], 0.5 * cap.ly + piles.centre[1]]
-            top = cap.thickness
-            zkeys.append(top)
-            zlimits.append((0.0, top, size.shaft))
-    xs = graded_planes(-0.5 * soil.lx, 0.5 * soil.lx, xkeys, xzones, size.h, size.growth,
-                       size.h_max)
-    ys = graded_planes(-0.5 * soil.ly, 0.5 * soil.ly, ykeys, yzones, size.h, size.growth,
-                       size.h_max)
-    zs = graded_planes(-soil.depth, top, zkeys, zzones, size.h, size.growth, size.h_max,
-                       zlimits)
-    return Grid(xs, ys, zs)
-
-
-def _layer_of(z: np.ndarray, spec: Substructure) -> np.ndarray:
-    tops = np.array(spec.soil.layer_tops())
-    return np.clip(np.searchsorted(-tops, -z, side='right') - 1, 0, len(tops) - 1)
-
-
 def vertical_stress(z: np.ndarray, spec: Substructure) -> np.ndarray:
     """Return the geostatic total vertical stress at depth -z (Pa, compression positive)."""
     z = np.minimum(np.asarray(z, dtype=float), 0.0)
@@ -248,12 +198,6 @@ def vertical_stress(z: np.ndarray, spec: Substructure) -> np.ndarray:
     return out
 
 
-def planned_nodes(spec: Substructure) -> int:
-    """Return the number of grid nodes the mesh of ``spec`` will have (cheap: planes only)."""
-    nx, ny, nz = _planes(spec).shape
-    return nx * ny * nz
-
-
 def build(spec: Substructure, load: Optional[PileLoad] = None) -> PileSoilModel:
     """
     Build the substructure of ``spec`` (and check it against ``load`` if given).
@@ -261,256 +205,193 @@ def build(spec: Substructure, load: Optional[PileLoad] = None) -> PileSoilModel:
     Raises
     ------
     FoundationError
-        On inconsistent records (see :func:`~.records.check_substructure`) or a
+        On inconsistent records (see :func:`~.consistency.check_substructure`) or a
         mesh whose aspect ratio exceeds ``mesh.max_aspect``.
 
     """
     check_substructure(spec, load)
-    soil, piles, cap = spec.soil, spec.piles, spec.cap
-    grid = _planes(spec)
-    nx, ny, nz = grid.shape
-    ci, cj, ck = grid.cell_index()
-    centres = grid.cell_centres()
-    n_layers = len(soil.layers)
-    kind = np.full(len(centres), SOIL)
-    material = _layer_of(centres[:, 2], spec)
-    pile_of = np.full(len(centres), -1)
-    keep = centres[:, 2] < 0
-    if piles is not None:
-        half = 0.5 * piles.width
-        for p, (x, y) in enumerate(piles.centres()):
-            inside = ((np.abs(centres[:, 0] - x) < half) & (np.abs(centres[:, 1] - y) < half)
-                      & (centres[:, 2] > -piles.length) & (centres[:, 2] < 0))
-            pile_of[inside] = p
-        kind[pile_of >= 0] = PILE
-        material[pile_of >= 0] = n_layers
-        if cap.enabled:
-            on_cap = ((np.abs(centres[:, 0] - piles.centre[0]) < 0.5 * cap.lx)
-                      & (np.abs(centres[:, 1] - piles.centre[1]) < 0.5 * cap.ly)
-                      & (centres[:, 2] > 0))
-            kind[on_cap] = CAP
-            material[on_cap] = n_layers + 1
-            keep |= on_cap
-    # structured node ids of every cell, then periodic ties and node renumbering
-    corner = np.array([[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0],
-                       [0, 0, 1], [1, 0, 1], [1, 1, 1], [0, 1, 1]])
-    ii = ci[:, None] + corner[:, 0]
-    jj = cj[:, None] + corner[:, 1]
-    kk = ck[:, None] + corner[:, 2]
-    zg, yg, xg = np.meshgrid(grid.zs, grid.ys, grid.xs, indexing='ij')
-    all_xyz = np.column_stack([xg.ravel(), yg.ravel(), zg.ravel()])
-    cell_xyz = all_xyz[grid.node_id(ii, jj, kk)[keep]]
-    if soil.periodic:
-        ii = np.where(ii == nx - 1, 0, ii)
-        jj = np.where(jj == ny - 1, 0, jj)
-    structured_cells = grid.node_id(ii, jj, kk)
-    kept = np.flatnonzero(keep)
-    cell_map = np.full(len(centres), -1)
-    cell_map[kept] = np.arange(len(kept))
-    cells_s = structured_cells[kept]
-    used = np.unique(cells_s)
-    node_map = np.full(nx * ny * nz, -1)
-    node_map[used] = np.arange(len(used))
-    cells = node_map[cells_s]
-    nodes = all_xyz[used]
-    kind = kind[kept]
-    material = material[kept]
-    pile_of = pile_of[kept]
-    ci, cj, ck = ci[kept], cj[kept], ck[kept]
-    n_soil_nodes = len(nodes)
+    grid = soil_grid(spec)
+    tags = tag_cells(spec, grid)
+    cut = grid_cells(grid, tags.keep, spec.soil.periodic)
+    tags = tags.kept()
+    split = split_interface(spec, cut, tags)
+    outer = _outer_faces(cut, tags, spec.soil.periodic)
+    mesh = _mesh(split, tags, outer)
+    aspect = check_aspect(spec, cut.coordinates, tags.material)
+    n_dofs = 3 * mesh.n_nodes
+    mats = _materials(spec)
+    cells = mesh.cells
+    dofs = node_dofs(cells)
+    lumped = hex8.lumped_mass(cut.coordinates, mats.density[tags.material])
+    mass = np.bincount(np.repeat(cells.ravel(), 3) * 3 + np.tile(np.arange(3), cells.size),
+                       weights=np.repeat(lumped.ravel(), 3), minlength=n_dofs)
+    k_soil, c_soil = _linear_operators(np.flatnonzero(tags.kind == SOIL), dofs, cut.coordinates,
+                                       tags.material, mats, lumped, n_dofs)
+    k_str, c_str = _linear_operators(np.flatnonzero(tags.kind != SOIL), dofs, cut.coordinates,
+                                     tags.material, mats, lumped, n_dofs)
+    structure_dofs = np.zeros(n_dofs, dtype=bool)
+    structure_dofs[dofs[tags.kind != SOIL].ravel()] = True
+    free, k_b, c_b = _boundary(spec, mesh, outer, cut.coordinates, mats, n_dofs)
+    iface, law = _interface(spec, split, n_dofs)
+    head_d, head_r = head_operators(spec.piles.count if spec.piles else 0, cut, cells,
+                                    mesh.nodes, tags.pile, n_dofs)
+    surface_w = surface_weights(cut, tags.kind, cells, mesh.n_nodes)
+    points = soil_points(spec, cut, cells, n_dofs)
+    summary = _summary(spec, mesh, tags.kind, aspect, iface, n_dofs, free)
+    _report(summary, load)
+    return PileSoilModel(spec, grid, mesh, tags.kind, free, mass, k_soil, c_soil, k_str, c_str,
+                         k_b, c_b, iface, law, structure_dofs, head_d, head_r, surface_w,
+                         points, summary)
 
-    # duplicate the nodes on the pile surfaces for the Desai interface
-    faces_a = np.zeros((0, 4), dtype=int)
-    faces_b = np.zeros((0, 4), dtype=int)
-    face_layer = np.zeros(0, dtype=int)
-    if piles is not None and spec.interface.model == 'desai':
-        pile_nodes = np.unique(cells[kind == PILE])
-        soil_nodes = np.unique(cells[kind == SOIL])
-        shared = np.intersect1d(pile_nodes, soil_nodes)
-        dup = np.arange(n_soil_nodes)
-        dup[shared] = n_soil_nodes + np.arange(len(shared))
-        original = cells.copy()
-        structural = kind != SOIL
-        cells[structural] = dup[cells[structural]]
-        nodes = np.vstack([nodes, nodes[shared]])
-        # interface faces: pile-cell faces whose neighbour is a soil cell
-        cx, cy, cz = grid.cell_shape
-        steps = [(-1, 0, 0), (1, 0, 0), (0, -1, 0), (0, 1, 0), (0, 0, -1), (0, 0, 1)]
-        pid = np.flatnonzero(kind == PILE)
-        fa, fb, fl = [], [], []
-        for f, (di, dj, dk) in enumerate(steps):
-            ni, nj, nk = ci[pid] + di, cj[pid] + dj, ck[pid] + dk
-            inside = (ni >= 0) & (ni < cx) & (nj >= 0) & (nj < cy) & (nk >= 0) & (nk < cz)
-            neighbour = np.full(len(pid), -1)
-            neighbour[inside] = cell_map[grid.cell_id(ni[inside], nj[inside], nk[inside])]
-            ok = neighbour >= 0
-            ok[ok] = kind[neighbour[ok]] == SOIL
-            sel = pid[ok]
-            fb.append(cells[sel][:, HEX_FACES[f]])
-            fa.append(original[sel][:, HEX_FACES[f]])
-            fl.append(material[neighbour[ok]])
-        faces_a = np.vstack(fa)
-        faces_b = np.vstack(fb)
-        face_layer = np.concatenate(fl)
 
-    mesh = Mesh(nodes, cells, material)
+def _outer_faces(cut: GridCells, tags: CellTags,
+                 periodic: bool) -> list[tuple[str, int, np.ndarray]]:
+    """Return (name, face, soil cells) of the sides and base (the base alone if periodic)."""
+    faces = (4,) if periodic else (0, 1, 2, 3, 4)
+    return [(FACE_NAMES[f], f, np.flatnonzero(cut.on_outer_face(f) & (tags.kind == SOIL)))
+            for f in faces]
+
+
+def _mesh(split: InterfaceSplit, tags: CellTags,
+          outer: list[tuple[str, int, np.ndarray]]) -> Mesh:
+    """Return the mesh: cell sets 'soil', 'pile', 'cap'; face and node sets of the outside."""
+    kind = tags.kind
+    mesh = Mesh(split.nodes, split.cells, tags.material)
     mesh.cell_sets = {'soil': np.flatnonzero(kind == SOIL), 'pile': np.flatnonzero(kind == PILE),
                       'cap': np.flatnonzero(kind == CAP)}
-    n_dofs = 3 * len(nodes)
-    aspect = Mesh(cell_xyz.reshape(-1, 3), np.arange(8 * len(cells)).reshape(-1, 8),
-                  material).aspect_ratios()
-    if aspect.max() > spec.mesh.max_aspect:
-        message = (f'the mesh has elements of aspect ratio {aspect.max():.3g} > '
-                   f'soil.mesh.max_aspect = {spec.mesh.max_aspect:g}; lower soil.mesh.h_max '
-                   f'or soil.mesh.h_shaft, or raise soil.mesh.h')
-        raise FoundationError(message)
+    for name, f, sel in outer:
+        faces = split.cells[sel][:, HEX_FACES[f]]
+        mesh.face_sets[name] = faces
+        mesh.node_sets[name] = np.unique(faces)
+    return mesh
 
-    # materials
+
+@dataclass(frozen=True)
+class _Materials:
+    """Per material (the layers, then pile, then cap): elastic constants and Rayleigh damping."""
+
+    young: np.ndarray
+    poisson: np.ndarray
+    density: np.ndarray
+    alpha: np.ndarray
+    beta: np.ndarray
+
+
+def _materials(spec: Substructure) -> _Materials:
+    """Return the materials of the layers, the piles and the cap."""
+    soil, piles, cap = spec.soil, spec.piles, spec.cap
     young = np.array([lay.E for lay in soil.layers] + [piles.E if piles else 1.0, cap.E])
     poisson = np.array([lay.nu for lay in soil.layers] + [piles.nu if piles else 0.0, cap.nu])
     density = np.array([lay.rho for lay in soil.layers] + [piles.rho if piles else 1.0, cap.rho])
     zeta = np.array([lay.damping_ratio for lay in soil.layers]
                     + [piles.damping_ratio if piles else 0.0, cap.damping_ratio])
     alpha, beta = rayleigh_coefficients(zeta, spec.rayleigh_frequencies)
-    dofs = node_dofs(cells)
-    coords = cell_xyz
-    lumped = hex8.lumped_mass(coords, density[material])
-    mass = np.bincount(np.repeat(cells.ravel(), 3) * 3 + np.tile(np.arange(3), cells.size),
-                       weights=np.repeat(lumped.ravel(), 3), minlength=n_dofs)
+    return _Materials(young, poisson, density, alpha, beta)
 
-    def group(sel: np.ndarray) -> tuple[sp.csr_matrix, sp.csr_matrix]:
-        if len(sel) == 0:
-            z = sp.csr_matrix((n_dofs, n_dofs))
-            return z, z
 
-        def kernel(ids: np.ndarray) -> np.ndarray:
-            e = sel[ids]
-            k = hex8.stiffness(coords[e], young[material[e]], poisson[material[e]])
-            return k * (1.0 + 1j * beta[material[e]])[:, None, None]
+def _linear_operators(sel: np.ndarray, dofs: np.ndarray, coords: np.ndarray,
+                      material: np.ndarray, mats: _Materials, lumped: np.ndarray,
+                      n_dofs: int) -> tuple[sp.csr_matrix, sp.csr_matrix]:
+    """
+    Return the stiffness K and Rayleigh damping alpha M + beta K of the cells ``sel``.
 
-        both = hex8.assemble_chunked(n_dofs, dofs[sel], kernel, dtype=complex)
-        stiff = sp.csr_matrix((both.data.real.copy(), both.indices, both.indptr),
-                              shape=both.shape)
-        m_alpha = np.bincount(dofs[sel].ravel(),
-                              weights=np.repeat(lumped[sel] * alpha[material[sel]][:, None],
-                                                3, axis=1).ravel(), minlength=n_dofs)
-        damp = sp.csr_matrix((both.data.imag.copy(), both.indices, both.indptr),
-                             shape=both.shape) + sp.diags(m_alpha)
-        return stiff, damp.tocsr()
+    K and beta K are assembled together, as the real and imaginary parts of one
+    complex matrix, so that they share one pattern.
+    """
+    if len(sel) == 0:
+        z = sp.csr_matrix((n_dofs, n_dofs))
+        return z, z
 
-    k_soil, c_soil = group(np.flatnonzero(kind == SOIL))
-    k_str, c_str = group(np.flatnonzero(kind != SOIL))
-    structure_dofs = np.zeros(n_dofs, dtype=bool)
-    structure_dofs[dofs[kind != SOIL].ravel()] = True
+    def kernel(ids: np.ndarray) -> np.ndarray:
+        e = sel[ids]
+        k = hex8.stiffness(coords[e], mats.young[material[e]], mats.poisson[material[e]])
+        return k * (1.0 + 1j * mats.beta[material[e]])[:, None, None]
 
-    # boundary
+    both = assemble_chunked(n_dofs, dofs[sel], kernel, dtype=complex)
+    stiff = sp.csr_matrix((both.data.real.copy(), both.indices, both.indptr), shape=both.shape)
+    m_alpha = np.bincount(dofs[sel].ravel(),
+                          weights=np.repeat(lumped[sel] * mats.alpha[material[sel]][:, None],
+                                            3, axis=1).ravel(), minlength=n_dofs)
+    damp = sp.csr_matrix((both.data.imag.copy(), both.indices, both.indptr),
+                         shape=both.shape) + sp.diags(m_alpha)
+    return stiff, damp.tocsr()
+
+
+def _boundary(spec: Substructure, mesh: Mesh, outer: list[tuple[str, int, np.ndarray]],
+              coords: np.ndarray, mats: _Materials, n_dofs: int
+              ) -> tuple[np.ndarray, sp.csr_matrix, sp.csr_matrix]:
+    """
+    Return the free DOFs and the boundary's springs and dashpots (K, C).
+
+    ``fixed`` fixes the base and the sides' normal displacement; ``viscoelastic``
+    puts springs and dashpots on the outer faces, ``lysmer`` dashpots only.
+    """
+    soil, piles = spec.soil, spec.piles
+    lumping = cast(Lumping, soil.boundary_lumping)
     source = np.array([piles.centre[0], piles.centre[1], 0.0]) if piles else np.zeros(3)
-    cx, cy, cz = grid.cell_shape
-    outer = [('xmin', ci == 0, 0), ('xmax', ci == cx - 1, 1), ('ymin', cj == 0, 2),
-             ('ymax', cj == cy - 1, 3), ('zmin', ck == 0, 4)]
-    if soil.periodic:
-        outer = outer[-1:]
     free = np.ones(n_dofs, dtype=bool)
     k_b = sp.csr_matrix((n_dofs, n_dofs))
     c_b = sp.csr_matrix((n_dofs, n_dofs))
-    for name, on, f in outer:
-        sel = np.flatnonzero(on & (kind == SOIL))
-        faces = cells[sel][:, HEX_FACES[f]]
-        mesh.face_sets[name] = faces
-        mesh.node_sets[name] = np.unique(faces)
+    for name, f, sel in outer:
+        faces = mesh.face_sets[name]
         if soil.boundary == 'fixed':
             if name == 'zmin':
                 free[node_dofs(mesh.node_sets[name][:, None]).ravel()] = False
             else:
                 free[3 * mesh.node_sets[name] + 'xy'.index(name[0])] = False
             continue
-        lay = material[sel]
+        lay = mesh.material[sel]
         g = np.array([soil.layers[m].G for m in lay])
-        rho = density[lay]
+        rho = mats.density[lay]
         vs = np.array([soil.layers[m].vs for m in lay])
         vp = np.array([soil.layers[m].vp for m in lay])
-        face_xyz = cell_xyz[sel][:, HEX_FACES[f]]
+        face_xyz = coords[sel][:, HEX_FACES[f]]
         r = np.linalg.norm(face_xyz.mean(axis=1) - source, axis=1)
         kn, kt, cn, ct = viscoelastic_coefficients(g, rho, vs, vp, r, soil.alpha_t,
                                                    soil.alpha_n)
         if soil.boundary == 'lysmer':
             kn, kt = 0 * kn, 0 * kt
         else:
-            k_b = k_b + _faces_matrix(n_dofs, face_xyz, faces, kn, kt, soil.boundary_lumping)
-        c_b = c_b + _faces_matrix(n_dofs, face_xyz, faces, cn, ct, soil.boundary_lumping)
+            k_b = k_b + boundary_matrix(n_dofs, mesh.nodes, faces, kn, kt, lumping,
+                                        coords=face_xyz)
+        c_b = c_b + boundary_matrix(n_dofs, mesh.nodes, faces, cn, ct, lumping, coords=face_xyz)
+    return free, k_b.tocsr(), c_b.tocsr()
 
-    # interface
-    iface: Optional[InterfaceSet] = None
-    law: Optional[DesaiLaw] = None
-    if len(faces_a):
-        iface = interface_set(nodes, faces_a, faces_b, spec.interface.thickness, n_dofs)
-        gp = np.einsum('ga,eai->egi', FACE_N, nodes[faces_b])
-        lay = np.broadcast_to(face_layer[:, None], gp.shape[:2])
-        e_l = np.array([x.E for x in soil.layers])[lay]
-        nu_l = np.array([x.nu for x in soil.layers])[lay]
-        phi = np.radians(np.array([x.phi for x in soil.layers]))[lay]
-        c_l = np.array([x.c for x in soil.layers])[lay]
-        k_n0, k_s0 = initial_moduli(e_l, nu_l, 'lame' if spec.interface.shear_modulus == 'lame'
-                                    else 'G')
-        sigma_v = vertical_stress(gp[..., 2], spec)
-        k0 = (1 - np.sin(phi)) if spec.interface.k0 <= 0 else spec.interface.k0
-        vertical = np.abs(iface.frames[:, :, 0, 2]) > 0.5
-        sigma_n0 = np.where(vertical, sigma_v, k0 * sigma_v)
-        law = DesaiLaw(k_n0, k_s0, spec.interface.adhesion_ratio * c_l,
-                       spec.interface.friction_ratio * np.tan(phi), sigma_n0,
-                       spec.interface.failure_ratio)
 
-    # observation: pile heads
-    n_piles = piles.count if piles else 0
-    rows_d, cols_d, vals_d = [], [], []
-    rows_r, cols_r, vals_r = [], [], []
-    for p in range(n_piles):
-        sel = np.flatnonzero((pile_of == p) & (np.abs(grid.zs[ck + 1]) < 1e-9))
-        faces = cells[sel][:, HEX_FACES[5]]
-        _, weights = face_frames(nodes[faces])
-        w = np.bincount(faces.ravel(), weights=np.einsum('ga,eg->ea', FACE_N, weights).ravel(),
-                        minlength=len(nodes))
-        head = np.flatnonzero(w)
-        wn = w[head] / w[head].sum()
-        for axis in range(3):
-            rows_d.append(np.full(len(head), 3 * p + axis))
-            cols_d.append(3 * head + axis)
-            vals_d.append(wn)
-        r = nodes[head] - wn @ nodes[head]
-        inertia = np.einsum('a,a->', wn, (r**2).sum(1)) * np.eye(3) - np.einsum('a,ai,aj->ij',
-                                                                                wn, r, r)
-        cross = np.zeros((len(head), 3, 3))
-        cross[:, 0, 1], cross[:, 0, 2] = -r[:, 2], r[:, 1]
-        cross[:, 1, 0], cross[:, 1, 2] = r[:, 2], -r[:, 0]
-        cross[:, 2, 0], cross[:, 2, 1] = -r[:, 1], r[:, 0]
-        op = np.einsum('ij,a,ajk->iak', np.linalg.inv(inertia), wn, cross)
-        for axis in range(3):
-            rows_r.append(np.full(3 * len(head), 3 * p + axis))
-            cols_r.append(node_dofs(head[:, None]).ravel())
-            vals_r.append(op[axis].ravel())
-    shape = (3 * n_piles, n_dofs)
+def _interface(spec: Substructure, split: InterfaceSplit,
+               n_dofs: int) -> tuple[Optional[InterfaceSet], Optional[DesaiLaw]]:
+    """
+    Return the Desai interface elements and their law at the geostatic state (or None).
 
-    def op_matrix(r: list, c: list, v: list) -> sp.csr_matrix:
-        if not r:
-            return sp.csr_matrix(shape)
-        return sp.csr_matrix((np.concatenate(v), (np.concatenate(r), np.concatenate(c))),
-                             shape=shape)
+    Initial stress: sigma_v = sum rho g h above the Gauss point, K0 sigma_v on the
+    shafts and sigma_v under the tips.
+    """
+    if not len(split.faces_a):
+        return None, None
+    soil, interface = spec.soil, spec.interface
+    nodes, faces_b = split.nodes, split.faces_b
+    iface = interface_set(nodes, split.faces_a, faces_b, interface.thickness, n_dofs)
+    gp = np.einsum('ga,eai->egi', FACE_N, nodes[faces_b])
+    lay = np.broadcast_to(split.face_layer[:, None], gp.shape[:2])
+    e_l = np.array([x.E for x in soil.layers])[lay]
+    nu_l = np.array([x.nu for x in soil.layers])[lay]
+    phi = np.radians(np.array([x.phi for x in soil.layers]))[lay]
+    c_l = np.array([x.c for x in soil.layers])[lay]
+    k_n0, k_s0 = initial_moduli(e_l, nu_l, 'lame' if interface.shear_modulus == 'lame'
+                                else 'G')
+    sigma_v = vertical_stress(gp[..., 2], spec)
+    k0 = (1 - np.sin(phi)) if interface.k0 <= 0 else interface.k0
+    vertical = np.abs(iface.frames[:, :, 0, 2]) > 0.5
+    sigma_n0 = np.where(vertical, sigma_v, k0 * sigma_v)
+    law = DesaiLaw(k_n0, k_s0, interface.adhesion_ratio * c_l,
+                   interface.friction_ratio * np.tan(phi), sigma_n0, interface.failure_ratio)
+    return iface, law
 
-    head_d = op_matrix(rows_d, cols_d, vals_d)
-    head_r = op_matrix(rows_r, cols_r, vals_r)
 
-    # ground surface weights
-    top_cells = np.flatnonzero((np.abs(grid.zs[ck + 1]) < 1e-9) & (kind != CAP))
-    faces = cells[top_cells][:, HEX_FACES[5]]
-    _, weights = face_frames(cell_xyz[top_cells][:, HEX_FACES[5]])
-    surface_w = np.bincount(faces.ravel(),
-                            weights=np.einsum('ga,eg->ea', FACE_N, weights).ravel(),
-                            minlength=len(nodes))
-
-    points = _soil_points(spec, grid, cell_map, cells, n_dofs)
-    summary = _summary(spec, mesh, kind, aspect, iface, n_dofs, free)
+def _report(summary: dict, load: Optional[PileLoad]) -> None:
+    """Log the model's size, and warn when a dynamic load is above what the mesh carries."""
     LOG.info('pile-soil substructure: %d nodes, %d DOFs, %d soil / %d pile / %d cap cells, '
-             '%d interface elements, f_max %.3g Hz', len(nodes), n_dofs,
+             '%d interface elements, f_max %.3g Hz', summary['nodes'], summary['dofs'],
              summary['soil_cells'], summary['pile_cells'], summary['cap_cells'],
              summary['interface_elements'], summary['f_max'])
     dynamic = load is not None and load.type not in ('static', 'none')
@@ -518,73 +399,11 @@ def build(spec: Substructure, load: Optional[PileLoad] = None) -> PileSoilModel:
         LOG.warning('load frequency %.3g Hz is above the %.3g Hz the coarsest soil elements '
                     'carry: outgoing waves are under-resolved far from the piles',
                     load.frequency, summary['f_max'])
-    return PileSoilModel(spec, grid, mesh, kind, free, mass, k_soil, c_soil, k_str, c_str,
-                         k_b.tocsr(), c_b.tocsr(), iface, law, structure_dofs, head_d, head_r,
-                         surface_w, points, summary)
-
-
-def _faces_matrix(n_dofs: int, face_xyz: np.ndarray, faces: np.ndarray, normal: np.ndarray,
-                  tangential: np.ndarray, lumping: str) -> sp.csr_matrix:
-    if len(faces) == 0:
-        return sp.csr_matrix((n_dofs, n_dofs))
-    mats = face_matrices(face_xyz, normal, tangential, lumping)  # type: ignore[arg-type]
-    return assemble(n_dofs, node_dofs(faces), mats)
-
-
-def _soil_points(spec: Substructure, grid: Grid, cell_map: np.ndarray, cells: np.ndarray,
-                 n_dofs: int) -> SoilPoints:
-    obs, piles = spec.observation, spec.piles
-    positions: list[tuple[float, float, float]] = []
-    names: list[str] = []
-    if piles is not None:
-        centres = piles.centres()
-        if obs.line_points > 0:
-            y = centres[0][1] + 0.5 * piles.spacing
-            x0 = centres[0][0] - 0.5 * piles.spacing
-            x1 = centres[piles.cols - 1][0] + 0.5 * piles.spacing
-            for n, x in enumerate(np.linspace(x0, x1, obs.line_points)):
-                positions.append((float(x), y, 0.0))
-                names.append(f'line_{n + 1:02d}')
-        if obs.val_points and piles.count >= 14:
-            off = 0.5 * piles.width + 1.0
-            a = (centres[4][0], centres[4][1] - off, 0.0)
-            b = (centres[13][0], centres[13][1] + off, 0.0)
-            mid = tuple(0.5 * (p + q) for p, q in zip(a, b))
-            positions += [a, b, mid]  # type: ignore[list-item]
-            names += ['val_1', 'val_2', 'val_3']
-    for n, point in enumerate(obs.points):
-        positions.append(tuple(float(v) for v in point))  # type: ignore[arg-type]
-        names.append(f'user_{n + 1:02d}')
-    if not positions:
-        return SoilPoints(np.zeros((0, 3)), (), sp.csr_matrix((0, n_dofs)))
-    pos = np.array(positions, dtype=float)
-    try:
-        structured, local = grid.locate(pos)
-    except ValueError as err:
-        raise FoundationError(f'output.soil_points: {err}') from None
-    cell = cell_map[structured]
-    # a point on the ground outside the cap falls in a dropped cell above: take the one below
-    cx, cy, _ = grid.cell_shape
-    below = (cell < 0) & (local[:, 2] <= -1 + 1e-9)
-    if np.any(below):
-        cell[below] = cell_map[structured[below] - cx * cy]
-        local[below, 2] = 1.0
-    if np.any(cell < 0):
-        bad = pos[cell < 0].tolist()
-        raise FoundationError(f'output.soil_points {bad} lie outside the modelled solid')
-    shape = hex8.shape_functions(local)
-    node_ids = cells[cell]
-    rows = (3 * np.arange(len(pos))[:, None, None] + np.arange(3)[None, None, :])
-    rows = np.broadcast_to(rows, (len(pos), 8, 3))
-    cols = 3 * node_ids[:, :, None] + np.arange(3)
-    vals = np.broadcast_to(shape[:, :, None], (len(pos), 8, 3))
-    op = sp.csr_matrix((vals.ravel(), (rows.ravel(), cols.ravel())), shape=(3 * len(pos),
-                                                                            n_dofs))
-    return SoilPoints(pos, tuple(names), op)
 
 
 def _summary(spec: Substructure, mesh: Mesh, kind: np.ndarray, aspect: np.ndarray,
              iface: Optional[InterfaceSet], n_dofs: int, free: np.ndarray) -> dict:
+    """Return DOF and cell counts, element sizes and the highest frequency carried."""
     x = mesh.nodes[mesh.cells]
     soil = kind == SOIL
     span = x.max(axis=1) - x.min(axis=1)

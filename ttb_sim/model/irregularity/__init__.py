@@ -15,23 +15,26 @@
 """
 Track irregularity: the public face of the modules of this package.
 
+- :mod:`.spectrum_records`: a spectrum's components and families, their integrals.
 - :mod:`.spectra`: spectrum families (Chinese HSR, Sato, German, FRA) and
   their band integrals.
 - :mod:`.profile`: a realised profile on a grid (:class:`TrackIrregularity`)
   and its sampling with derivatives.
 - :mod:`.synthesis`: random profiles from spectra, layers and presets.
 - :mod:`.measured`: measured profiles from CSV, and CSV output.
-- :mod:`.variance`: the V8/V10 variance check of the synthesis.
+- :data:`GRID_SLACK`: the tolerance, in grid steps, for positions and lengths on a
+  profile's grid (shared with the couplings that sample profiles).
 """
 
 from ttb_sim.model.irregularity._checks import GRID_SLACK
 from ttb_sim.model.irregularity.measured import CSV_COLUMNS, load_csv, MIN_CSV_ROWS, save_csv
 from ttb_sim.model.irregularity.profile import (IrregularitySample, RAIL_QUANTITIES,
                                                 TrackIrregularity)
-from ttb_sim.model.irregularity.spectra import (band_rms, band_variance, COMPONENTS,
-                                                CONTACT_SPACING, get_spectrum,
-                                                SATO_DEFAULT_ROUGHNESS, sato_spectrum, SPECTRA,
-                                                SpectrumComponent, SpectrumFamily)
+from ttb_sim.model.irregularity.spectra import (band_rms, band_variance, CONTACT_SPACING,
+                                                get_spectrum, SATO_DEFAULT_ROUGHNESS,
+                                                sato_spectrum, SPECTRA)
+from ttb_sim.model.irregularity.spectrum_records import (COMPONENTS, SpectrumComponent,
+                                                         SpectrumFamily)
 from ttb_sim.model.irregularity.synthesis import (available_spectra, IrregularityLayer,
                                                   MIN_RECORD_WAVELENGTHS, PRESETS, synthesize)
 

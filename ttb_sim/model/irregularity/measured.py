@@ -148,6 +148,17 @@ def load_csv(
         If ``dx`` is given and is not a finite number > 0.
 
     """
+    rows, content = _read_rows(path)
+    header, data_index = _header(path, rows, content)
+    numbers, row_numbers = _numbers(path, rows, header, data_index)
+    x = numbers[:, 0]
+    rails = numbers[:, 1:].T
+    steps, covered = _check_x(path, x, row_numbers, min_length)
+    return _resampled(path, x, rails, steps, covered, dx)
+
+
+def _read_rows(path: str | PathLike[str]) -> tuple[list[list[str]], np.ndarray]:
+    """Return the CSV rows of a file and the indices of its content (not blank, not #) rows."""
     text = read_user_file(path, 'irregularity file', MAX_CSV_BYTES, encoding='utf-8-sig')
     lines = text.splitlines()
     try:
@@ -162,7 +173,12 @@ def load_csv(
         raise _refuse(path, 1, f'no header and no data rows; expected a header row naming '
                       f'the columns {", ".join(CSV_COLUMNS)} (or no header and exactly five '
                       'numeric columns in that order)')
+    return rows, content
 
+
+def _header(path: str | PathLike[str], rows: list[list[str]],
+            content: np.ndarray) -> tuple[list[str], np.ndarray]:
+    """Return the column names (the header's, or CSV_COLUMNS without one) and the data rows."""
     header_index = int(content[0])
     header = [name.strip() for name in rows[header_index]]
     if header and all(_parses_as_float(name) for name in header):  # no header: numbers
@@ -186,14 +202,21 @@ def load_csv(
             raise _refuse(path, header_index + 1,
                           f'duplicated column(s) {", ".join(duplicated)}')
         data_index = content[1:]
-    row_numbers = data_index + 1
     if data_index.size < MIN_CSV_ROWS:
+        row_numbers = data_index + 1
         last = f'last data row {row_numbers[-1]}' if data_index.size else 'no data rows'
         message = (
             f'too few rows: {data_index.size} data row(s) ({last}), need at least '
             f'{MIN_CSV_ROWS}')
         raise _refuse(path, int(row_numbers[-1]) if data_index.size else header_index + 1,
                       message)
+    return header, data_index
+
+
+def _numbers(path: str | PathLike[str], rows: list[list[str]], header: list[str],
+             data_index: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Return the values (n, 5) of CSV_COLUMNS in the data rows and the rows' line numbers."""
+    row_numbers = data_index + 1
     widths = np.fromiter(map(len, rows), dtype=np.intp, count=len(rows))[data_index]
     wrong = np.flatnonzero(widths != len(header))
     if wrong.size:
@@ -222,9 +245,12 @@ def load_csv(
         message = (f'value {shown(str(cells[r, c]))} in column {CSV_COLUMNS[c]} is not a finite '
                    'number')
         raise _refuse(path, int(row_numbers[r]), message)
+    return numbers, row_numbers
 
-    x = numbers[:, 0]
-    rails = numbers[:, 1:].T
+
+def _check_x(path: str | PathLike[str], x: np.ndarray, row_numbers: np.ndarray,
+             min_length: float | None) -> tuple[np.ndarray, float]:
+    """Return the steps of x and the length it covers, checked increasing and long enough."""
     with np.errstate(over='ignore', invalid='ignore'):  # a span over 1.8e308 m: refused below
         steps = np.diff(x)
     decreasing = np.flatnonzero(steps <= 0.0)
@@ -241,7 +267,12 @@ def load_csv(
             f'profile too short: it covers {covered:g} m (x = {x[0]:g} to {x[-1]:g} m, last '
             f'data row {row_numbers[-1]}), {float(min_length):g} m is needed')
         raise _refuse(path, int(row_numbers[-1]), message)
+    return steps, covered
 
+
+def _resampled(path: str | PathLike[str], x: np.ndarray, rails: np.ndarray, steps: np.ndarray,
+               covered: float, dx: float | None) -> TrackIrregularity:
+    """Return the profile on its rows (uniform, no dx) or resampled onto a uniform grid."""
     spacing = float(np.median(steps))
     if not (math.isfinite(covered) and spacing > 0.0 and math.isfinite(spacing)):
         raise _refuse(path, None, f'x spans {covered:g} m with a median spacing of {spacing:g} m; '

@@ -57,7 +57,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from ttb_sim.errors import ModelError
 from ttb_sim.model.irregularity._checks import GRID_SLACK
-from ttb_sim.model.irregularity.spectra import COMPONENTS
+from ttb_sim.model.irregularity.spectrum_records import COMPONENTS
 
 __all__ = [
     'IrregularitySample',
@@ -150,7 +150,7 @@ class TrackIrregularity:
 
     def __post_init__(self) -> None:
         if not (math.isfinite(self.x_start) and math.isfinite(self.dx) and self.dx > 0.0):
-            raise ValueError(f'need finite x_start and dx > 0, got {self.x_start}, {self.dx}')
+            raise ModelError(f'need finite x_start and dx > 0, got {self.x_start}, {self.dx}')
         shape = None
         for name in ('values', 'slopes', 'curvatures'):
             arr = getattr(self, name)
@@ -160,11 +160,11 @@ class TrackIrregularity:
                 arr.flags.writeable = False
                 object.__setattr__(self, name, arr)
             if arr.ndim != 2 or arr.shape[0] != len(RAIL_QUANTITIES) or arr.shape[1] < 2:
-                raise ValueError(f'{name} must have shape (4, N) with N >= 2, got {arr.shape}')
+                raise ModelError(f'{name} must have shape (4, N) with N >= 2, got {arr.shape}')
             if shape is not None and arr.shape != shape:
-                raise ValueError(f'{name} has shape {arr.shape}, values has {shape}')
+                raise ModelError(f'{name} has shape {arr.shape}, values has {shape}')
             if not np.all(np.isfinite(arr)):
-                raise ValueError(f'{name} contains non-finite numbers')
+                raise ModelError(f'{name} contains non-finite numbers')
             shape = arr.shape
 
     @property
@@ -225,7 +225,7 @@ class TrackIrregularity:
 
         Raises
         ------
-        ValueError
+        ModelError
             If the component name is unknown.
 
         """
@@ -238,7 +238,7 @@ class TrackIrregularity:
             return 0.5 * (y_l + y_r)
         if component == 'gauge':
             return y_l - y_r
-        raise ValueError(f'unknown component {component!r}; expected one of {COMPONENTS}')
+        raise ModelError(f'unknown component {component!r}; expected one of {COMPONENTS}')
 
     def sample(
         self, x: ArrayLike, *, outside: Literal['raise', 'zero'] = 'raise',
@@ -280,7 +280,7 @@ class TrackIrregularity:
                     f'position x = {bad:g} m is outside it (generate or load a longer profile)')
                 raise ModelError(message)
             if outside != 'zero':
-                raise ValueError(f"outside must be 'raise' or 'zero', got {outside!r}")
+                raise ModelError(f"outside must be 'raise' or 'zero', got {outside!r}")
             s = np.where(inside, s, 0.0)
         i = np.clip(np.floor(s), 0, last - 1).astype(np.intp)
         t = s - i

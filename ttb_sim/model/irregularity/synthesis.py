@@ -53,8 +53,9 @@ from scipy import fft
 from ttb_sim.errors import ModelError
 from ttb_sim.model.irregularity._checks import check_positive, GRID_SLACK, to_float
 from ttb_sim.model.irregularity.profile import TrackIrregularity
-from ttb_sim.model.irregularity.spectra import (COMPONENTS, get_spectrum, SPECTRA,
-                                                SpectrumComponent, SpectrumFamily)
+from ttb_sim.model.irregularity.spectra import get_spectrum, SPECTRA
+from ttb_sim.model.irregularity.spectrum_records import (COMPONENTS, SpectrumComponent,
+                                                         SpectrumFamily)
 
 __all__ = [
     'IrregularityLayer',
@@ -234,8 +235,26 @@ def synthesize(
     x_start = to_float('x_start', x_start)
     if not math.isfinite(x_start):
         raise ModelError(f'x_start must be finite, got {x_start!r}')
+    parts = _parts(layers)
+    longest = max(hi for _, _, _, hi in parts)
+    n_req = _n_points(length, dx)
+    n_fft = max(n_req, _n_points(MIN_RECORD_WAVELENGTHS * longest, dx))
+    if n_fft > MAX_POINTS:
+        message = (
+            f'irregularity grid of {n_fft} points (length {length:g} m, longest wavelength '
+            f'{longest:g} m, dx {dx:g} m) exceeds the limit of {MAX_POINTS}; increase dx')
+        raise ModelError(message)
+    coefficients = _half_spectra(parts, len(layers), seed, scale, n_fft, dx)
+    values, slopes, curvatures = _profiles(coefficients, n_fft, n_req, dx)
+    _LOG.debug('synthesised %s: %d points (FFT %d), dx %g m, seed %d, scale %g',
+               label, n_req, n_fft, dx, seed, scale)
+    return TrackIrregularity(x_start, dx, values, slopes, curvatures,
+                             source=f'{label} seed={seed} scale={scale:g}')
 
-    # Resolve every (layer, component) and its band.
+
+def _parts(layers: tuple[IrregularityLayer, ...]
+           ) -> list[tuple[int, SpectrumComponent, float, float]]:
+    """Return every (layer index, component, wavelength_min, wavelength_max) to synthesise."""
     parts: list[tuple[int, SpectrumComponent, float, float]] = []
     for j, layer in enumerate(layers):
         family = get_spectrum(layer.spectrum)
@@ -248,21 +267,22 @@ def synthesize(
             parts.append((j, comp, lo, hi))
     if not parts:
         raise ModelError('no spectrum component selected')
-    longest = max(hi for _, _, _, hi in parts)
+    return parts
 
-    n_req = _n_points(length, dx)
-    n_fft = max(n_req, _n_points(MIN_RECORD_WAVELENGTHS * longest, dx))
-    if n_fft > MAX_POINTS:
-        message = (
-            f'irregularity grid of {n_fft} points (length {length:g} m, longest wavelength '
-            f'{longest:g} m, dx {dx:g} m) exceeds the limit of {MAX_POINTS}; increase dx')
-        raise ModelError(message)
+
+def _half_spectra(parts: list[tuple[int, SpectrumComponent, float, float]], n_layers: int,
+                  seed: int, scale: float, n_fft: int, dx: float) -> np.ndarray:
+    """
+    Return the half-spectra (4, n_fft // 2 + 1) of the track-geometry components.
+
+    Rows in :data:`COMPONENTS` order; each bin carries the exact variance of its
+    frequency interval, with a random phase from the layer's and component's
+    own stream of ``seed``.
+    """
     n_half = n_fft // 2 + 1
     top = (n_fft - 1) // 2          # highest bin below Nyquist
     dn = 1.0 / (n_fft * dx)
-
-    streams = [s.spawn(len(COMPONENTS)) for s in np.random.SeedSequence(seed).spawn(len(layers))]
-    # Half-spectra of the track-geometry components, in COMPONENTS order.
+    streams = [s.spawn(len(COMPONENTS)) for s in np.random.SeedSequence(seed).spawn(n_layers)]
     coefficients = np.zeros((len(COMPONENTS), n_half), dtype=complex)
     for j, comp, lo, hi in parts:
         n_lo, n_hi = 1.0 / hi, 1.0 / lo
@@ -282,7 +302,14 @@ def synthesize(
         amplitude = scale * np.sqrt(2.0 * var)
         # irfft(Y)[m] = sum_k |Y_k| (2 / N) cos(2 pi k m / N + arg Y_k) for 0 < k < N/2
         coefficients[c, k] += 0.5 * n_fft * amplitude * np.exp(1j * phases[k])
+    return coefficients
 
+
+def _profiles(coefficients: np.ndarray, n_fft: int, n_req: int,
+              dx: float) -> list[np.ndarray]:
+    """Return the rail values, slopes and curvatures (4, n_req each, read-only)."""
+    n_half = coefficients.shape[1]
+    dn = 1.0 / (n_fft * dx)
     vertical, alignment, cross_level, gauge = coefficients
     rails = np.stack([vertical + 0.5 * cross_level, vertical - 0.5 * cross_level,
                       alignment + 0.5 * gauge, alignment - 0.5 * gauge])
@@ -293,8 +320,4 @@ def synthesize(
         arr = np.ascontiguousarray(arr)
         arr.flags.writeable = False
         arrays.append(arr)
-    _LOG.debug('synthesised %s: %d points (FFT %d), dx %g m, seed %d, scale %g',
-               label, n_req, n_fft, dx, seed, scale)
-    values, slopes, curvatures = arrays
-    return TrackIrregularity(x_start, dx, values, slopes, curvatures,
-                             source=f'{label} seed={seed} scale={scale:g}')
+    return arrays

@@ -16,8 +16,9 @@
 Vehicles: the car record, its DOFs and matrices, modal tools, and the train models.
 
 ``car`` holds the car record (:class:`CarParameters`, the scenario's ``car``
-section), ``dofs`` the body/component indexing of the 42-DOF car, ``matrices``
-its mass, stiffness, damping, gyroscopic and contact maps (and a train of cars),
+section), ``dofs`` the body/component indexing of the 42-DOF car, ``suspension``
+its suspension elements, stiffness and damping, ``matrices`` its mass and
+gyroscopic matrices, contact maps and the matrices of a car and of a train of cars,
 ``modal`` the eigen-analysis used by V4, ``train`` the vehicle models a scenario
 runs (moving forces, quarter cars, multibody cars).  The linear hunting
 analysis is :mod:`ttb_sim.model.vehicle.stability` (imported on its own).
@@ -28,12 +29,13 @@ from ttb_sim.model.vehicle.dofs import (BODY_NAMES, BOGIES, CAR_BODY, COMPONENTS
                                         DOF_PER_BODY, dofs, N_BODIES, N_DOF, SIDES, wheelset_dofs,
                                         WHEELSETS)
 from ttb_sim.model.vehicle.matrices import (car_matrices, CarMatrices, contact_map,
-                                            contact_spring_stiffness, ContactMap, damping_matrix,
-                                            gravity_vector, gyroscopic_matrix, mass_matrix,
-                                            point_motion_matrix, stiffness_matrix,
-                                            suspension_elements, SuspensionElements,
-                                            train_matrices, TrainMatrices)
+                                            contact_spring_stiffness, ContactMap, gravity_vector,
+                                            gyroscopic_matrix, mass_matrix, train_matrices,
+                                            TrainMatrices)
 from ttb_sim.model.vehicle.modal import eigenfrequencies, modal_damping_ratios
+from ttb_sim.model.vehicle.suspension import (damping_matrix, point_motion_matrix,
+                                              stiffness_matrix, suspension_elements,
+                                              SuspensionElements)
 from ttb_sim.model.vehicle.train import Axles, MovingForces, MultibodyCars, QuarterCars, Vehicle
 
 __all__ = ['Axles', 'BODY_NAMES', 'body_positions', 'BOGIES', 'CAR_BODY', 'car_matrices',

@@ -27,10 +27,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ttb_sim.declarations import check_declared, param
 from ttb_sim.errors import ModelError
 from ttb_sim.model.constants import GRAVITY
 from ttb_sim.model.vehicle.dofs import N_BODIES
-from ttb_sim.parameters import check_declared, param
 
 
 @dataclass(frozen=True)
@@ -41,7 +41,7 @@ class CarParameters:
     Units are SI: masses kg, inertias kg m^2, stiffness per spring N/m (8 axle
     boxes and 4 air springs per car), damping per damper N s/m (the ``*_dampers``
     counts say how many act per car, smeared evenly over the spring positions),
-    lengths m.  Every field is declared with :func:`~ttb_sim.parameters.param`,
+    lengths m.  Every field is declared with :func:`~ttb_sim.declarations.param`,
     so it is settable from a scenario file as ``car.<field>``.
     """
 

@@ -20,10 +20,12 @@ Wheel-rail contact: the public face of the modules of this package.
 - :mod:`.creep`: Kalker's linear creep coefficients and forces, their load
   scaling, Shen-Hedrick-Elkins saturation and its derivatives.
 - :mod:`.geometry`: wheelset contact geometry (equivalent cone) and creepages.
-- :mod:`.profiles`: parametric wheel and rail profiles and the
-  contact-geometry table.
+- :mod:`.profiles`: parametric wheel and rail profiles.
+- :mod:`.contact_table`: the contact-geometry table of a wheelset on them.
+- :mod:`.contact_parameters`: the contact record of the scenario.
 """
 
+from ttb_sim.model.wheel_rail.contact_table import contact_geometry_table, ContactGeometryTable
 from ttb_sim.model.wheel_rail.creep import (creep_coefficients, CREEP_LOAD_EXPONENTS,
                                             FRICTION_COEFFICIENT, kalker_coefficients,
                                             KALKER_RATIO_RANGE, linear_creep_forces,
@@ -35,8 +37,7 @@ from ttb_sim.model.wheel_rail.hertz import (hertz_constant, hertz_ellipse, Hertz
                                             linearised_stiffness, normal_force,
                                             normal_force_derivative, POISSON_RATIO,
                                             static_compression, TREADS, YOUNG_MODULUS)
-from ttb_sim.model.wheel_rail.profiles import (contact_geometry_table, ContactGeometryTable,
-                                               Profile, rail_profile, RailParameters,
+from ttb_sim.model.wheel_rail.profiles import (Profile, rail_profile, RailParameters,
                                                wheel_profile, WheelParameters)
 
 __all__ = [

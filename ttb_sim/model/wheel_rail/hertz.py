@@ -214,6 +214,19 @@ def _curvature_ratio(g: np.ndarray) -> np.ndarray:
     return (e / (g * g) - k) / (k - e)
 
 
+def _axis_ratio(ratio: np.ndarray) -> np.ndarray:
+    """Return the minor/major axis ratio g of the ellipse whose B/A is ``ratio`` (>= 1)."""
+    # Vectorised bisection on log(g) for _curvature_ratio(g) = ratio (decreasing in g).
+    lo = np.full(ratio.shape, math.log(1e-6))
+    hi = np.zeros(ratio.shape)
+    for _ in range(64):
+        mid = 0.5 * (lo + hi)
+        too_round = _curvature_ratio(np.exp(mid)) < ratio
+        hi = np.where(too_round, mid, hi)
+        lo = np.where(too_round, lo, mid)
+    return np.where(ratio <= 1.0 + 1e-12, 1.0, np.exp(0.5 * (lo + hi)))
+
+
 def hertz_ellipse(load: ArrayLike, rolling_radius: ArrayLike = 0.46,
                   rail_transverse_radius: ArrayLike = 0.30, *,
                   wheel_transverse_radius: ArrayLike = math.inf,
@@ -272,16 +285,7 @@ def hertz_ellipse(load: ArrayLike, rolling_radius: ArrayLike = 0.46,
                          'x and y must be > 0 (radii: positive convex, negative concave)')
     p, a_cur, b_cur = np.broadcast_arrays(p, a_cur, b_cur)
     small = np.minimum(a_cur, b_cur)
-    ratio = np.maximum(a_cur, b_cur) / small
-    # Vectorised bisection on log(g) for _curvature_ratio(g) = ratio (decreasing in g).
-    lo = np.full(ratio.shape, math.log(1e-6))
-    hi = np.zeros(ratio.shape)
-    for _ in range(64):
-        mid = 0.5 * (lo + hi)
-        too_round = _curvature_ratio(np.exp(mid)) < ratio
-        hi = np.where(too_round, mid, hi)
-        lo = np.where(too_round, lo, mid)
-    g = np.where(ratio <= 1.0 + 1e-12, 1.0, np.exp(0.5 * (lo + hi)))
+    g = _axis_ratio(np.maximum(a_cur, b_cur) / small)
     m = 1.0 - g * g
     k, e = ellipk(m), ellipe(m)
     e_star = young_modulus / (2.0 * (1.0 - poisson_ratio ** 2))

@@ -18,7 +18,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ttb_sim.model.bridge import Structure
+from ttb_sim.model.structure import Structure
 from ttb_sim.model.vehicle.train import MovingForces
 from ttb_sim.sim.coupling.base import FreeDofState, girder_wheel_load, VehicleOutputs
 from ttb_sim.sim.coupling.girder_load import MovingLoad

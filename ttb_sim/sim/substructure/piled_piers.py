@@ -65,8 +65,8 @@ from typing import Callable
 import numpy as np
 import scipy.linalg as sla
 
-from ttb_sim.model.bridge import PiledPier, Structure
 from ttb_sim.model.foundation.operator import TOP
+from ttb_sim.model.structure import PiledPier, Structure
 
 
 @dataclass

@@ -51,8 +51,8 @@ import numpy as np
 from ttb_sim.config import Scenario
 from ttb_sim.errors import DivergenceError, ScenarioError
 from ttb_sim.fe.factorization import resolve
-from ttb_sim.model.foundation.substructure import (build, CAP, PILE, PileSoilModel, planned_nodes,
-                                                   SOIL)
+from ttb_sim.model.foundation.soil_mesh import CAP, PILE, planned_nodes, SOIL
+from ttb_sim.model.foundation.substructure import build, PileSoilModel
 from ttb_sim.sim.cost import CostEstimate, STEP_BUDGET
 from ttb_sim.sim.frames import Frame, Layout
 from ttb_sim.sim.substructure.stepping import (implicit_dofs, initial_state, mixed_stable_step,

@@ -55,7 +55,8 @@ import scipy.sparse.linalg as sla
 from ttb_sim.fe.assembly import assemble, assemble_links
 from ttb_sim.fe.beam import global_matrices, NODE_DOFS
 from ttb_sim.fe.mindlin import MindlinPlate, plate_matrices, PlateMesh, rectangular_mesh
-from ttb_sim.model.track import BeamLine, build_track, POISSON_CONCRETE, TrackMesh, TrackParameters
+from ttb_sim.model.beam_line import BeamLine
+from ttb_sim.model.track import build_track, POISSON_CONCRETE, TrackMesh, TrackParameters
 from ttb_sim.validation.rows import Case, relative_row, Row
 
 LOG = logging.getLogger(__name__)

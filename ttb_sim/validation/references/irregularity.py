@@ -28,7 +28,8 @@ import math
 import numpy as np
 
 from ttb_sim.errors import ModelError
-from ttb_sim.model.irregularity.spectra import get_spectrum, SpectrumFamily
+from ttb_sim.model.irregularity.spectra import get_spectrum
+from ttb_sim.model.irregularity.spectrum_records import SpectrumFamily
 from ttb_sim.model.irregularity.synthesis import MIN_RECORD_WAVELENGTHS, synthesize
 
 __all__ = [

@@ -40,9 +40,10 @@ from typing import Any, Callable
 
 import numpy as np
 
-from ttb_sim.model.bridge import GirderLine, Structure
+from ttb_sim.model.bridge import GirderLine
 from ttb_sim.model.constants import GRAVITY
 from ttb_sim.model.irregularity import GRID_SLACK, TrackIrregularity
+from ttb_sim.model.structure import Structure
 from ttb_sim.model.vehicle.train import QuarterCars
 from ttb_sim.sim.coupling.base import FreeDofState, girder_wheel_load, VehicleOutputs
 from ttb_sim.sim.coupling.quarter_car import wheel_kernels

@@ -71,13 +71,13 @@ import math
 import numpy as np
 
 from ttb_sim.errors import DivergenceError, ModelError
-from ttb_sim.model.bridge import Structure
 from ttb_sim.model.irregularity import TrackIrregularity
+from ttb_sim.model.structure import Structure
 from ttb_sim.model.vehicle.car import CarParameters
 from ttb_sim.model.vehicle.matrices import gyroscopic_matrix, train_matrices, TrainMatrices
 import ttb_sim.model.wheel_rail as ct
-from ttb_sim.model.wheel_rail.parameters import ContactParameters
-from ttb_sim.model.wheel_rail.profiles import contact_geometry_table, ContactGeometryTable
+from ttb_sim.model.wheel_rail.contact_parameters import ContactParameters
+from ttb_sim.model.wheel_rail.contact_table import contact_geometry_table, ContactGeometryTable
 from ttb_sim.sim.coupling.base import FreeDofState, VehicleOutputs
 from ttb_sim.sim.coupling.train_track.contact_step import (COMPONENTS, ContactKernels, ContactStep,
                                                            Predictor, RailUnderWheels, Solution)

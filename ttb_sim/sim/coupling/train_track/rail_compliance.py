@@ -29,7 +29,7 @@ import math
 import numpy as np
 import scipy.sparse as sp
 
-from ttb_sim.model.track import BeamLine
+from ttb_sim.model.beam_line import BeamLine
 from ttb_sim.sim.integrators.protocol import Integrator
 
 PROBE_SPACING = 24

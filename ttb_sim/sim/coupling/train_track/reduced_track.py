@@ -61,10 +61,10 @@ import scipy.sparse as sp
 
 from ttb_sim.fe.beam import field_rows, offset_rows
 from ttb_sim.fe.factorization import factorize
-from ttb_sim.model.bridge import Structure
 from ttb_sim.model.irregularity import TrackIrregularity
+from ttb_sim.model.structure import Structure
 from ttb_sim.model.vehicle.car import CarParameters
-from ttb_sim.model.wheel_rail.parameters import ContactParameters
+from ttb_sim.model.wheel_rail.contact_parameters import ContactParameters
 from ttb_sim.sim.coupling.train_track.multibody import TrainTrackCoupling
 from ttb_sim.sim.coupling.train_track.rail_compliance import RailCompliance
 from ttb_sim.sim.integrators.newmark import Newmark

@@ -13,7 +13,7 @@
 # limitations under the License.
 
 """
-The assembled bridge (`assemble_structure`) against closed forms.
+The assembled structure (`assemble_structure`) of girders, bearings and piers: closed forms.
 
 Girder defaults: L = 32 m, EI = 4.646e11 N m^2, m = 35200 kg/m (PHYSICS.md 5), so
 f1 = pi / (2 L^2) sqrt(EI / m) = 5.5730 Hz. The girders are cubic Hermite (Euler-
@@ -27,9 +27,10 @@ import numpy as np
 import pytest
 import scipy.linalg as la
 import scipy.sparse.linalg as sla
-from ttb_sim.model.bridge import (assemble_structure, bearing_forces, BearingParameters,
-                                  BridgeParameters, FoundationParameters, PierParameters,
-                                  span_frequency)
+from ttb_sim.model.bearings import bearing_forces, BearingParameters
+from ttb_sim.model.bridge import BridgeParameters, PierParameters, span_frequency
+from ttb_sim.model.foundation.pier_foundations import FoundationParameters
+from ttb_sim.model.structure import assemble_structure
 
 GIRDER = BridgeParameters()
 L, EI, M = GIRDER.span_length, GIRDER.bending_stiffness, GIRDER.mass_per_length

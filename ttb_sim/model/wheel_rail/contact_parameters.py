@@ -18,7 +18,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from ttb_sim.parameters import check_declared, param
+from ttb_sim.declarations import check_declared, param
 
 __all__ = ['ContactParameters']
 

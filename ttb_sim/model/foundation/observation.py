@@ -1,0 +1,186 @@
+# Copyright 2026 The ttb_sim Authors
+#
+# Licensed under the Apache License, Version 2.0 (the "License");
+# you may not use this file except in compliance with the License.
+# You may obtain a copy of the License at
+#
+#     http://www.apache.org/licenses/LICENSE-2.0
+#
+# Unless required by applicable law or agreed to in writing, software
+# distributed under the License is distributed on an "AS IS" BASIS,
+# WITHOUT WARRANTIES OR CONDITIONS OF ANY KIND, either express or implied.
+# See the License for the specific language governing permissions and
+# limitations under the License.
+
+"""
+The observation operators of the pile-soil substructure: pile heads, ground surface, soil points.
+
+Pile-head displacement is the area-weighted mean over the head nodes (the
+work-conjugate of a uniform head pressure), pile-head rotation a weighted
+least-squares rigid fit; the ground surface carries tributary areas for
+uniform surface loads; soil points interpolate trilinearly in the containing
+cell.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.sparse as sp
+
+from ttb_sim.errors import FEError
+from ttb_sim.fe import hex8
+from ttb_sim.fe.assembly import skew
+from ttb_sim.fe.mesh import GridCells, HEX_FACES, node_dofs
+from ttb_sim.fe.quad import face_frames, FACE_N
+from ttb_sim.model.foundation.records import FoundationError, Substructure
+from ttb_sim.model.foundation.soil_mesh import CAP
+
+#: Local face of a cell on its top (+z).
+_TOP = 5
+
+
+@dataclass(frozen=True)
+class SoilPoints:
+    """Soil observation points: positions (p, 3) m, names, interpolation (3p x n_dofs)."""
+
+    positions: np.ndarray
+    names: tuple[str, ...]
+    operator: sp.csr_matrix
+
+
+def _on_ground(cut: GridCells) -> np.ndarray:
+    """Return the mask of cells whose top face lies on the ground surface z = 0."""
+    return np.abs(cut.grid.zs[cut.index[2] + 1]) < 1e-9
+
+
+def _tributary(faces: np.ndarray, weights: np.ndarray, n_nodes: int) -> np.ndarray:
+    """Return the tributary area int N_a dA of each node over faces (n_nodes,) (m^2)."""
+    return np.bincount(faces.ravel(), weights=np.einsum('ga,eg->ea', FACE_N, weights).ravel(),
+                       minlength=n_nodes)
+
+
+def _head_rows(nodes: np.ndarray, w: np.ndarray
+               ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Return the head nodes, their normalised weights and the (3, k, 3) rigid-rotation fit."""
+    head = np.flatnonzero(w)
+    wn = w[head] / w[head].sum()
+    r = nodes[head] - wn @ nodes[head]
+    inertia = np.einsum('a,a->', wn, (r**2).sum(1)) * np.eye(3) - np.einsum('a,ai,aj->ij',
+                                                                            wn, r, r)
+    op = np.einsum('ij,a,ajk->iak', np.linalg.inv(inertia), wn, skew(r))
+    return head, wn, op
+
+
+def head_operators(n_piles: int, cut: GridCells, cells: np.ndarray, nodes: np.ndarray,
+                   pile: np.ndarray, n_dofs: int) -> tuple[sp.csr_matrix, sp.csr_matrix]:
+    """
+    Return the pile-head mean displacement and rigid rotation operators (3 n_piles, n_dofs).
+
+    Rows are (pile, axis). The head of a pile is the top face of its cells on the
+    ground surface; ``cells`` and ``nodes`` are the mesh's (interface copies
+    included), ``pile`` the pile of each cell (-1: none).
+    """
+    rows_d, cols_d, vals_d = [], [], []
+    rows_r, cols_r, vals_r = [], [], []
+    on_ground = _on_ground(cut)
+    for p in range(n_piles):
+        sel = np.flatnonzero((pile == p) & on_ground)
+        faces = cells[sel][:, HEX_FACES[_TOP]]
+        _, weights = face_frames(nodes[faces])
+        head, wn, op = _head_rows(nodes, _tributary(faces, weights, len(nodes)))
+        for axis in range(3):
+            rows_d.append(np.full(len(head), 3 * p + axis))
+            cols_d.append(3 * head + axis)
+            vals_d.append(wn)
+        for axis in range(3):
+            rows_r.append(np.full(3 * len(head), 3 * p + axis))
+            cols_r.append(node_dofs(head[:, None]).ravel())
+            vals_r.append(op[axis].ravel())
+    shape = (3 * n_piles, n_dofs)
+
+    def op_matrix(r: list, c: list, v: list) -> sp.csr_matrix:
+        if not r:
+            return sp.csr_matrix(shape)
+        return sp.csr_matrix((np.concatenate(v), (np.concatenate(r), np.concatenate(c))),
+                             shape=shape)
+
+    return op_matrix(rows_d, cols_d, vals_d), op_matrix(rows_r, cols_r, vals_r)
+
+
+def surface_weights(cut: GridCells, kind: np.ndarray, cells: np.ndarray,
+                    n_nodes: int) -> np.ndarray:
+    """Return the tributary area of the ground-surface nodes outside the cap (n_nodes,) (m^2)."""
+    top_cells = np.flatnonzero(_on_ground(cut) & (kind != CAP))
+    faces = cells[top_cells][:, HEX_FACES[_TOP]]
+    _, weights = face_frames(cut.coordinates[top_cells][:, HEX_FACES[_TOP]])
+    return _tributary(faces, weights, n_nodes)
+
+
+def _positions(spec: Substructure) -> tuple[list[tuple[float, float, float]], list[str]]:
+    """Return the positions and names of the soil points ``spec.observation`` asks for."""
+    obs, piles = spec.observation, spec.piles
+    positions: list[tuple[float, float, float]] = []
+    names: list[str] = []
+    if piles is not None:
+        centres = piles.centres()
+        if obs.line_points > 0:
+            y = centres[0][1] + 0.5 * piles.spacing
+            x0 = centres[0][0] - 0.5 * piles.spacing
+            x1 = centres[piles.cols - 1][0] + 0.5 * piles.spacing
+            for n, x in enumerate(np.linspace(x0, x1, obs.line_points)):
+                positions.append((float(x), y, 0.0))
+                names.append(f'line_{n + 1:02d}')
+        if obs.val_points and piles.count >= 14:
+            off = 0.5 * piles.width + 1.0
+            a = (centres[4][0], centres[4][1] - off, 0.0)
+            b = (centres[13][0], centres[13][1] + off, 0.0)
+            mid = tuple(0.5 * (p + q) for p, q in zip(a, b))
+            positions += [a, b, mid]  # type: ignore[list-item]
+            names += ['val_1', 'val_2', 'val_3']
+    for n, point in enumerate(obs.points):
+        positions.append(tuple(float(v) for v in point))  # type: ignore[arg-type]
+        names.append(f'user_{n + 1:02d}')
+    return positions, names
+
+
+def soil_points(spec: Substructure, cut: GridCells, cells: np.ndarray,
+                n_dofs: int) -> SoilPoints:
+    """
+    Return the soil observation points and their trilinear interpolation.
+
+    Raises
+    ------
+    FoundationError
+        If a point lies outside the modelled solid.
+
+    """
+    positions, names = _positions(spec)
+    if not positions:
+        return SoilPoints(np.zeros((0, 3)), (), sp.csr_matrix((0, n_dofs)))
+    pos = np.array(positions, dtype=float)
+    grid, cell_map = cut.grid, cut.cell_map
+    try:
+        structured, local = grid.locate(pos)
+    except FEError as err:
+        raise FoundationError(f'output.soil_points: {err}') from None
+    cell = cell_map[structured]
+    # a point on the ground outside the cap falls in a dropped cell above: take the one below
+    cx, cy, _ = grid.cell_shape
+    below = (cell < 0) & (local[:, 2] <= -1 + 1e-9)
+    if np.any(below):
+        cell[below] = cell_map[structured[below] - cx * cy]
+        local[below, 2] = 1.0
+    if np.any(cell < 0):
+        bad = pos[cell < 0].tolist()
+        raise FoundationError(f'output.soil_points {bad} lie outside the modelled solid')
+    shape = hex8.shape_functions(local)
+    node_ids = cells[cell]
+    rows = (3 * np.arange(len(pos))[:, None, None] + np.arange(3)[None, None, :])
+    rows = np.broadcast_to(rows, (len(pos), 8, 3))
+    cols = 3 * node_ids[:, :, None] + np.arange(3)
+    vals = np.broadcast_to(shape[:, :, None], (len(pos), 8, 3))
+    op = sp.csr_matrix((vals.ravel(), (rows.ravel(), cols.ravel())), shape=(3 * len(pos),
+                                                                            n_dofs))
+    return SoilPoints(pos, tuple(names), op)
