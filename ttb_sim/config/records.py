@@ -151,6 +151,11 @@ class SolverConfig:
                           "multi-time-step); 'monolithic' solves them as one system ([P] "
                           'Eq. 11, the reference; substructure_steps must be 1).',
                           choices=('partitioned', 'monolithic'))
+    threads: int = param(0, '-', 'Threads of the parallel kernels (the split solve of the '
+                         'lean variants, the rail predictor of multibody cars); 0 = auto: '
+                         'two when the 1-minute load average leaves at least 1.5 cores free, '
+                         'else one (two threads on a busy machine wait for each other). The '
+                         'results are the same bits with any count.', low=0, high=64)
     window_margin: float = param(30.0, 'm', "solver.variant 'reduced': detailed track kept "
                                  'behind the last axle and ahead of the first; more keeps '
                                  "more of the track's waves at more cost (README, "

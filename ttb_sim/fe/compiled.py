@@ -23,17 +23,22 @@ threads: the module binds ``prange = range`` for the plain function, and
 :func:`jit` rebinds it to ``numba.prange`` before compiling. One thread of the
 process at a time runs a parallel kernel (not every numba thread pool allows
 concurrent launches); another thread calling meanwhile runs the kernel's serial
-compilation, which computes the same bits. numba is imported only here, so the
-package imports without it and quickly.
+compilation, which computes the same bits. :func:`parallel_threads` limits the
+threads a parallel kernel may take; with one, every parallel kernel runs its
+serial compilation (no thread pool is started, nothing spins). numba is
+imported only here, so the package imports without it and quickly.
+:func:`pending` tells which of the kernels made so far are neither compiled nor
+in numba's disk cache: the ones the next steps will compile.
 """
 
 from __future__ import annotations
 
+from contextlib import contextmanager
 import importlib.util
 import logging
 import sys
 import threading
-from typing import Any, Callable
+from typing import Any, Callable, Iterator
 
 import numpy as np
 import scipy.sparse as sp
@@ -43,6 +48,25 @@ log = logging.getLogger(__name__)
 _CACHE: dict[tuple[Callable[..., Any], bool], Callable[..., Any] | None] = {}
 PARALLEL_LOCK = threading.Lock()
 """Held while a parallel kernel runs (module docstring)."""
+_THREADS = [0]
+"""Threads a parallel kernel may take: 0 = numba's own count, 1 = the serial compilation."""
+
+
+@contextmanager
+def parallel_threads(threads: int) -> Iterator[None]:
+    """
+    Let parallel kernels take at most ``threads`` threads inside a ``with`` block.
+
+    One thread runs each parallel kernel's serial compilation (the same bits,
+    module docstring); more lets numba take up to that many (and at most
+    ``NUMBA_NUM_THREADS``). 0 leaves numba's own count.
+    """
+    previous = _THREADS[0]
+    _THREADS[0] = int(threads)
+    try:
+        yield
+    finally:
+        _THREADS[0] = previous
 
 
 class _OneAtATime:
@@ -51,9 +75,15 @@ class _OneAtATime:
     def __init__(self, parallel: Callable[..., Any], serial: Callable[..., Any]) -> None:
         self.parallel = parallel
         self.serial = serial
+        self.py_func = getattr(serial, 'py_func')
 
     def __call__(self, *args: Any) -> Any:
+        threads = _THREADS[0]
+        if threads == 1:
+            return self.serial(*args)
         if PARALLEL_LOCK.acquire(blocking=False):
+            if threads > 1:
+                _set_numba_threads(threads)
             try:
                 return self.parallel(*args)
             finally:
@@ -124,3 +154,38 @@ def _jit_helpers(numba: Any, module: Any) -> None:
         function = getattr(module, helper)
         if not hasattr(function, 'py_func'):
             setattr(module, helper, numba.njit(cache=True, nogil=True)(function))
+
+
+def _set_numba_threads(threads: int) -> None:
+    """Set numba's thread count of this thread to ``threads`` (at most its pool's size)."""
+    import numba
+    numba.set_num_threads(min(threads, int(getattr(numba.config, 'NUMBA_NUM_THREADS'))))
+
+
+def pending() -> list[str]:
+    """
+    Return the names of the kernels made so far that the next calls will compile.
+
+    A kernel is pending when it has not been compiled in this process and numba's
+    disk cache holds no compilation of its current source. Without numba, or
+    where numba's cache cannot be read, the answer errs towards pending.
+    """
+    names = []
+    for (kernel, _parallel), dispatcher in _CACHE.items():
+        if dispatcher is None:
+            continue
+        serial = dispatcher.serial if isinstance(dispatcher, _OneAtATime) else dispatcher
+        if getattr(serial, 'signatures', None) or _in_disk_cache(kernel):
+            continue
+        names.append(kernel.__name__)
+    return sorted(set(names))
+
+
+def _in_disk_cache(kernel: Callable[..., Any]) -> bool:
+    """Tell whether numba's disk cache holds a compilation of ``kernel``'s current source."""
+    try:
+        from numba.core.caching import FunctionCache
+        index = FunctionCache(kernel)._cache_file._load_index()
+    except Exception:  # noqa: B902 - numba's cache layout is internal; any failure: not cached
+        return False
+    return bool(index)

@@ -30,7 +30,7 @@ factor of about 2 either way, more on a very different machine.
 from __future__ import annotations
 
 from dataclasses import asdict, dataclass
-from typing import Any
+from typing import Any, Sequence
 
 __all__ = ['CostEstimate', 'estimate_cost', 'STEP_BUDGET']
 
@@ -76,7 +76,14 @@ class CostEstimate:
     per_step_ms: float
     """Estimated cost of one step (ms)."""
     wall_time: float
-    """Estimated wall time of the stepping and writing (s), set-up not included."""
+    """Estimated wall time of the stepping and writing (s), set-up not included; with
+    kernels still to compile, their compilation included."""
+    threads: str = ''
+    """The threads of the parallel kernels and why (:func:`.resolve_threads`)."""
+    compiling: tuple[str, ...] = ()
+    """Kernels the run will compile on first use (not in numba's disk cache)."""
+    compile_time: float = 0.0
+    """Estimated CPU time of compiling them (s)."""
 
     def as_dict(self) -> dict[str, Any]:
         """Return the estimate as plain data (for ``summary.json``)."""
@@ -84,14 +91,35 @@ class CostEstimate:
 
     def describe(self) -> str:
         """Return one line for the user: the plan and the estimated time."""
-        return (f'{self.steps} steps of {self.dt:.3g} s ({self.duration:.4g} s simulated), '
+        line = (f'{self.steps} steps of {self.dt:.3g} s ({self.duration:.4g} s simulated), '
                 f'{self.free_dofs} free DOFs, {self.frames} frames x '
-                f'{self.messages // max(self.frames, 1)} topics; estimated '
-                f'{_duration(self.wall_time)} (a model: within about 2x)')
+                f'{self.messages // max(self.frames, 1)} topics')
+        if self.threads:
+            line += f', {self.threads}'
+        if self.compiling:
+            count = len(self.compiling)
+            line += (f'; compiling {count} kernel{"s" if count > 1 else ""} on first use '
+                     f'(about {_duration(self.compile_time)}, once)')
+        return (f'{line}; estimated {_duration(self.wall_time)} (a model: within about 2x)')
+
+
+COMPILE_S = {'contact_newton': 4.0, 'rail_rows': 1.5, 'rail_predictor': 1.5, 'history': 0.3,
+             'finish': 0.3, 'effective_load': 0.3, 'moving_load': 0.3}
+"""CPU time (s) of compiling a kernel with numba, where it is far from the typical one
+(measured with an empty cache: moving forces' four kernels 0.8 s, the quarter cars' four
+6.2 s, the multibody cars' eight 8-12 s)."""
+COMPILE_DEFAULT_S = 1.2
+"""CPU time (s) of compiling a typical kernel (a loop nest of a few dozen lines)."""
+
+
+def compile_time(kernels: Sequence[str]) -> float:
+    """Return the estimated CPU time (s) of compiling ``kernels`` (names)."""
+    return float(sum(COMPILE_S.get(name, COMPILE_DEFAULT_S) for name in kernels))
 
 
 def estimate_cost(*, steps: int, dt: float, free_dofs: int, cars: int, frames: int,
-                  messages_per_frame: int, variant: str) -> CostEstimate:
+                  messages_per_frame: int, variant: str, threads: str = '',
+                  compiling: Sequence[str] = ()) -> CostEstimate:
     """
     Estimate the wall time of a planned run.
 
@@ -111,6 +139,11 @@ def estimate_cost(*, steps: int, dt: float, free_dofs: int, cars: int, frames: i
         Messages per frame (topics).
     variant : str
         ``solver.variant``.
+    threads : str
+        The threads of the parallel kernels and why, for the plan line.
+    compiling : sequence of str
+        Kernels the run will compile on first use (their compilation joins the
+        estimate).
 
     Returns
     -------
@@ -123,10 +156,12 @@ def estimate_cost(*, steps: int, dt: float, free_dofs: int, cars: int, frames: i
     if cars:
         per_step += CONTACT_BASE_MS + CONTACT_PER_CAR_MS * (cars - 1)
     messages = frames * messages_per_frame
-    wall = OVERHEAD_S + (steps * per_step + messages * MESSAGE_MS) / 1000.0
+    compiling_s = compile_time(compiling)
+    wall = OVERHEAD_S + compiling_s + (steps * per_step + messages * MESSAGE_MS) / 1000.0
     return CostEstimate(steps=steps, dt=dt, duration=steps * dt, free_dofs=free_dofs,
                         cars=cars, frames=frames, messages=messages, per_step_ms=per_step,
-                        wall_time=wall)
+                        wall_time=wall, threads=threads, compiling=tuple(compiling),
+                        compile_time=compiling_s)
 
 
 def _duration(seconds: float) -> str:

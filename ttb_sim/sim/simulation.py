@@ -29,6 +29,7 @@ import numpy as np
 
 from ttb_sim.config import Scenario
 from ttb_sim.errors import DivergenceError, ModelError, ScenarioError
+from ttb_sim.fe.compiled import parallel_threads, pending
 from ttb_sim.model.bearings import bearing_forces
 from ttb_sim.model.constants import GRAVITY
 from ttb_sim.model.vehicle.train import MultibodyCars
@@ -39,7 +40,7 @@ from ttb_sim.sim.frames import Frame, Layout
 from ttb_sim.sim.integrators.newmark import Newmark
 from ttb_sim.sim.substructure.piled_piers import (InterfaceCheck, pile_coordinates, pile_outputs,
                                                   PiledFoundations, RigidDisplacement)
-from ttb_sim.sim.variants import blas_threads, solver_variant
+from ttb_sim.sim.variants import blas_threads, resolve_threads, solver_variant
 
 log = logging.getLogger(__name__)
 
@@ -132,6 +133,8 @@ class Simulation:
         self.n_steps = max(1, math.ceil(self.duration / dt - 1e-9))
         names = tuple(o.name for o in scenario.output.points)
         self.variant = solver_variant(scenario.solver.variant)
+        self.threads = resolve_threads(scenario.solver.threads)
+        """The threads of the parallel kernels (``solver.threads``), chosen once."""
         with blas_threads(self.variant.blas_threads):
             self.integrator = Newmark(st.mass, st.damping, st.stiffness, dt,
                                       method=self.variant.factorization,
@@ -219,7 +222,8 @@ class Simulation:
                              cars=self.vehicle.n_cars if isinstance(self.vehicle, MultibodyCars)
                              else 0,
                              frames=self.n_frames, messages_per_frame=messages_per_frame,
-                             variant=self.scenario.solver.variant)
+                             variant=self.scenario.solver.variant,
+                             threads=self.threads.describe(), compiling=pending())
 
     def describe(self) -> dict[str, Any]:
         """Return stepping details for ``summary.json`` (the solver section has the rest)."""
@@ -261,7 +265,7 @@ class Simulation:
             every frame before the failure has already been yielded.
 
         """
-        with blas_threads(self.variant.blas_threads):
+        with blas_threads(self.variant.blas_threads), parallel_threads(self.threads.count):
             yield from self._frames()
 
     def _frames(self) -> Iterator[Frame]:

@@ -43,6 +43,7 @@ from __future__ import annotations
 from contextlib import contextmanager
 from dataclasses import dataclass
 import logging
+import os
 from typing import Iterator
 
 log = logging.getLogger(__name__)
@@ -87,6 +88,48 @@ VARIANTS = {
     'reduced': SolverVariant('reduced', 'qdldl', lean=True, blas_threads=1, reduced=True),
 }
 """Every variant by name (the choices of ``solver.variant``)."""
+
+
+PARALLEL_WIDTH = 2
+"""Threads a parallel kernel can use: the split solve runs two halves."""
+AUTO_FREE_CORES = 1.5
+"""Cores the 1-minute load average must leave free for ``solver.threads = 0`` to take two."""
+
+
+@dataclass(frozen=True)
+class Threads:
+    """The threads a run's parallel kernels take, and why."""
+
+    count: int
+    reason: str
+
+    def describe(self) -> str:
+        """Return the choice for the plan line, e.g. '1 thread (auto: load 3.2 on 2 cores)'."""
+        return f'{self.count} thread{"s" if self.count > 1 else ""} ({self.reason})'
+
+
+def resolve_threads(requested: int) -> Threads:
+    """
+    Return the threads of a run's parallel kernels for ``solver.threads``.
+
+    A positive value is taken as it is. 0 (auto) takes two threads only when the
+    cores this process may run on, less the 1-minute load average, leave at
+    least :data:`AUTO_FREE_CORES` free, else one: two threads that wait for each
+    other on a busy machine made a step 3.5-11x slower than one thread (issue
+    #28). The results do not depend on the count.
+    """
+    if requested > 0:
+        return Threads(int(requested), 'solver.threads')
+    try:
+        cores = len(os.sched_getaffinity(0))
+    except (AttributeError, OSError):
+        cores = os.cpu_count() or 1
+    try:
+        load = os.getloadavg()[0]
+    except (AttributeError, OSError):
+        return Threads(1, f'auto: load unknown on {cores} cores')
+    count = PARALLEL_WIDTH if cores - load >= AUTO_FREE_CORES else 1
+    return Threads(count, f'auto: load {load:.1f} on {cores} cores')
 
 
 def solver_variant(name: str) -> SolverVariant:

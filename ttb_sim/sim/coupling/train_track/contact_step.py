@@ -88,16 +88,19 @@ class ContactKernels:
     rail_check: Callable[..., Any]
 
     @classmethod
-    def load(cls) -> ContactKernels:
+    def load(cls, irregular: bool = True) -> ContactKernels:
         """
         Return the kernels compiled, or their plain-Python sources.
 
         The sources compute the same numbers, about a thousand times slower: they
         run only where numba is not installed (or is switched off,
-        :data:`ttb_sim.sim.kernel_registry.ENABLED`), which is logged.
+        :data:`ttb_sim.sim.kernel_registry.ENABLED`), which is logged. A smooth
+        track (``irregular`` False) never samples the irregularity: its kernel
+        is not made, so it is neither compiled nor announced as to compile.
         """
         names = [f.name for f in fields(cls)]
-        found = [KERNELS.compiled(name) for name in names]
+        found = [KERNELS.compiled(name) if irregular or name != 'rail_irregularity'
+                 else KERNELS.source(name) for name in names]
         compiled = [kernel for kernel in found if kernel is not None]
         if len(compiled) < len(names):
             log.warning('numba is not available: the multibody contact step runs its '
