@@ -18,7 +18,9 @@ MkDocs hook: the repository's README.md is the site's home page.
 On GitHub the README sits at the repository root and links to ``docs/NAME.md``;
 the site's pages are the files of ``docs/``. This hook adds README.md to the
 site as ``index.md`` and rewrites its ``docs/`` links to the site's pages, and
-the pages' links to ``../README.md`` to the home page. Nothing is copied or
+the pages' links to ``../README.md`` to the home page. It also drops the
+backslash of an escaped pipe inside the code spans of table rows: GitHub needs
+the escape there, Python-Markdown keeps code spans whole and would show it. Nothing is copied or
 written into the repository.
 """
 
@@ -29,6 +31,7 @@ from mkdocs.structure.files import File
 
 _README_LINK = re.compile(r'\]\(\.\./README\.md')
 _DOCS_LINK = re.compile(r'\]\(docs/')
+_CODE_SPAN = re.compile(r'`[^`]*`')
 
 
 def on_files(files, config):
@@ -38,8 +41,20 @@ def on_files(files, config):
     return files
 
 
+def _table_pipes(markdown):
+    lines, fenced = markdown.split('\n'), False
+    for i, line in enumerate(lines):
+        if line.lstrip().startswith('```'):
+            fenced = not fenced
+        elif not fenced and line.startswith('|'):
+            lines[i] = _CODE_SPAN.sub(lambda m: m.group(0).replace('\\|', '|'), line)
+    return '\n'.join(lines)
+
+
 def on_page_markdown(markdown, page, config, files):
     """Point the README's ``docs/`` links, and the pages' README links, at the site's pages."""
     if page.file.src_uri == 'index.md':
-        return _DOCS_LINK.sub('](', markdown)
-    return _README_LINK.sub('](index.md', markdown)
+        markdown = _DOCS_LINK.sub('](', markdown)
+    else:
+        markdown = _README_LINK.sub('](index.md', markdown)
+    return _table_pipes(markdown)
