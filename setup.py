@@ -35,7 +35,7 @@ setup(
                       'PyYAML>=6', 'tqdm>=4.60',
                       # ttb-sim analyze / compare / sweep figures (Agg back-end, no display)
                       'matplotlib>=3.6',
-                      # solver.variant (README, Benchmark); each is optional at run time:
+                      # solver.variant (docs/performance.md); each is optional at run time:
                       # without it the variants fall back to scipy / leave BLAS threads as
                       # they are.
                       'cholespy>=2.0', 'qdldl>=0.1.7', 'threadpoolctl>=3',
