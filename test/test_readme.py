@@ -58,7 +58,7 @@ def test_ci_runs_the_readme_test_command_verbatim():
 
 
 def test_relative_links_of_readme_and_docs_resolve():
-    pages = [README, *sorted((ROOT / 'docs').glob('*.md'))]
+    pages = [README, *sorted((ROOT / 'docs').rglob('*.md'))]
     broken = []
     for page in pages:
         for target, _ in LINK.findall(page.read_text(encoding='utf-8')):

@@ -18,18 +18,20 @@ MkDocs hook: the repository's README.md is the site's home page.
 On GitHub the README sits at the repository root and links to ``docs/NAME.md``;
 the site's pages are the files of ``docs/``. This hook adds README.md to the
 site as ``index.md`` and rewrites its ``docs/`` links to the site's pages, and
-the pages' links to ``../README.md`` to the home page. It also drops the
+the pages' links to the README (``../README.md``, ``../../README.md``) to the home
+page. It also drops the
 backslash of an escaped pipe inside the code spans of table rows: GitHub needs
 the escape there, Python-Markdown keeps code spans whole and would show it. Nothing is copied or
 written into the repository.
 """
 
 from pathlib import Path
+import posixpath
 import re
 
 from mkdocs.structure.files import File
 
-_README_LINK = re.compile(r'\]\(\.\./README\.md')
+_README_LINK = re.compile(r'\]\((?:\.\./)+README\.md')
 _DOCS_LINK = re.compile(r'\]\(docs/')
 _CODE_SPAN = re.compile(r'`[^`]*`')
 
@@ -56,5 +58,6 @@ def on_page_markdown(markdown, page, config, files):
     if page.file.src_uri == 'index.md':
         markdown = _DOCS_LINK.sub('](', markdown)
     else:
-        markdown = _README_LINK.sub('](index.md', markdown)
+        home = posixpath.relpath('index.md', posixpath.dirname(page.file.src_uri) or '.')
+        markdown = _README_LINK.sub(f']({home}', markdown)
     return _table_pipes(markdown)
