@@ -18,11 +18,10 @@ MkDocs hook: the repository's README.md is the site's home page.
 On GitHub the README sits at the repository root and links to ``docs/NAME.md``;
 the site's pages are the files of ``docs/``. This hook adds README.md to the
 site as ``index.md`` and rewrites its ``docs/`` links to the site's pages, and
-the pages' links to the README (``../README.md``, ``../../README.md``) to the home
-page. It also drops the
-backslash of an escaped pipe inside the code spans of table rows: GitHub needs
-the escape there, Python-Markdown keeps code spans whole and would show it. Nothing is copied or
-written into the repository.
+the pages' links to the README (``../README.md``, ``../../README.md``) to the
+home page. It also drops the backslash of an escaped pipe inside the code spans
+of table rows: GitHub needs the escape there, Python-Markdown keeps code spans
+whole and would show it. Nothing is copied or written into the repository.
 """
 
 from pathlib import Path
