@@ -35,7 +35,7 @@ setup(
                       'PyYAML>=6', 'tqdm>=4.60',
                       # ttb-sim analyze / compare / sweep figures (Agg back-end, no display)
                       'matplotlib>=3.6',
-                      # solver.variant (README, Benchmark); each is optional at run time:
+                      # solver.variant (docs/performance.md); each is optional at run time:
                       # without it the variants fall back to scipy / leave BLAS threads as
                       # they are.
                       'cholespy>=2.0', 'qdldl>=0.1.7', 'threadpoolctl>=3',
@@ -45,6 +45,11 @@ setup(
     extras_require={
         # ttb-sim sweep --scheduler ADDRESS (a Dask distributed cluster)
         'dask': ['dask[distributed]>=2023.1'],
+        # the documentation site, `mkdocs build --strict` (mkdocs.yml; .ci/run builds it):
+        # mkdocs 1.6 for the README hook and anchor checks, mkdocstrings-python 2 for
+        # `filters: public`
+        'docs': ['mkdocs>=1.6', 'mkdocs-material>=9', 'mkdocstrings[python]>=1.0',
+                 'mkdocstrings-python>=2.0'],
         'test': ['dask[distributed]>=2023.1',
                  'pytest>=7', 'mcap>=1.1', 'mcap-ros2-support>=0.5', 'flake8>=6',
                  'flake8-quotes', 'flake8-import-order', 'flake8-builtins',

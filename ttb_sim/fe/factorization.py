@@ -31,7 +31,7 @@ once and then solved for many right-hand sides. The methods:
 ``qdldl``
     QDLDL's LDL^T with AMD order through the ``qdldl`` wheel: cheap to
     factorise, one right-hand side at a time; the fastest inside the time
-    step (README, Benchmark).
+    step (docs/performance.md).
 
 The symmetric methods read one triangle and need a symmetric positive
 definite (``cholmod``) or quasi-definite (``qdldl``, ``superlu_sym``) matrix;

@@ -22,7 +22,7 @@ cars (wheel-rail contact), times a factor for the solver variant; the
 per-message cost is the bag writer's. The constants were fitted to
 ``ttb-sim run`` on the project's 2-core machine under load (moving_force_beam,
 sprung_mass_beam, ten_span_train, track_approach, paper_ttbi with qdldl;
-README, Benchmark, for the variant factors): expect the real time within a
+docs/performance.md for the variant factors): expect the real time within a
 factor of about 2 either way, more on a very different machine.
 ``ttb-sim bench`` measures the real numbers.
 """
@@ -52,7 +52,7 @@ MESSAGE_MS = 0.08
 VARIANT_FACTOR = {'qdldl': 1.0, 'cholmod': 1.0, 'superlu_sym': 1.8, 'reference': 3.5,
                   'reduced': 0.6}
 """Per-step cost of the structure's solves and mat-vecs for each solver variant relative to
-qdldl (README, Benchmark); ``reduced`` only with multibody cars (else it is qdldl)."""
+qdldl (docs/performance.md); ``reduced`` only with multibody cars (else it is qdldl)."""
 
 
 @dataclass(frozen=True)

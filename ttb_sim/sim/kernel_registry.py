@@ -21,7 +21,7 @@ of its own; ``table.compiled(name)`` returns the source compiled by numba
 package directory is writable), or None when numba is not installed or
 :data:`ENABLED` is False. The caller then takes the kernel's numpy twin, which
 computes the same numbers. A kernel is used only where a measurement showed it
-wins (README, Benchmark). This module imports no kernel module: each registers
+wins (docs/performance.md). This module imports no kernel module: each registers
 its own.
 """
 

@@ -24,7 +24,7 @@ multibody cars (whose contact step every variant takes compiled; it agrees with
 the numpy step it replaced to round-off, ``test/sim/contact_oracle.py``).
 ``reduced`` is the one variant that changes the model, not only how it is
 solved: the track away from the train rides on the girder (an approximation
-with a stated range, README Benchmark); it is opt-in.
+with a stated range, docs/performance.md); it is opt-in.
 A pile-soil substructure on its own (``scenario.substructure_only``,
 :mod:`ttb_sim.sim.substructure.standalone`) reads the same table: ``reference`` steps
 it fully implicit (one factorisation of every DOF, the validated Newmark

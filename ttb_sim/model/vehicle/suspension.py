@@ -147,7 +147,7 @@ def point_motion_matrix(bodies: np.ndarray, offsets: np.ndarray,
     Return the matrices mapping car DOFs to the motion of material points.
 
     For a point at offset r from the centre of gravity of its body, the small
-    displacement is u + theta x r, i.e. [I | -skew(r)] [u; theta].
+    displacement is u + theta x r, i.e. ``[I | -skew(r)] [u; theta]``.
 
     Parameters
     ----------

@@ -21,7 +21,7 @@ rows of points on a beam with their slopes (the rail head under the wheels).
 Each computes what a general routine of the reference path computes, with
 fewer numpy calls and no full-size temporaries, for the one case a time step
 needs; results agree with the reference to round-off. Each was kept because a
-profile showed it wins (README, Benchmark).
+profile showed it wins (docs/performance.md).
 """
 
 from __future__ import annotations

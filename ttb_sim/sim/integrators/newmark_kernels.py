@@ -55,7 +55,7 @@ def effective_load(indptr: np.ndarray, indices: np.ndarray, data: np.ndarray,
 
     Each row's sum runs in scipy's order (from zero, entry by entry), so the
     result is ``force - A @ history`` bit for bit; measured twice as fast as
-    scipy's mat-vec on the paper_ttbi matrices (README, Benchmark).
+    scipy's mat-vec on the paper_ttbi matrices (docs/performance.md).
     """
     for i in range(out.shape[0]):
         acc = 0.0
