@@ -249,9 +249,11 @@ class BlockEncoder:
 
         """
         n = len(stamps)
+        with np.errstate(over='ignore'):   # beyond float32: inf, as the builders give
+            single = np.take(rows, self._f4, axis=1).astype('<f4')
         source = np.concatenate([
             np.take(rows, self._f8, axis=1).view(np.uint8).reshape(n, -1),
-            np.take(rows, self._f4, axis=1).astype('<f4').view(np.uint8).reshape(n, -1),
+            single.view(np.uint8).reshape(n, -1),
             _stamp_bytes(stamps),
             np.asarray(stamps, dtype='<u8').view(np.uint8).reshape(n, 8)], axis=1)
         out = np.tile(self.template, (n, 1))
