@@ -40,7 +40,7 @@ import pytest
 from rosbags.highlevel import AnyReader
 from ttb_sim.io import bag as bag_module
 from ttb_sim.io.bag import BagRecorder
-from ttb_sim.io.mcap_blocks import McapBlockStorage
+from ttb_sim.io.block_storage import McapBlockStorage
 from ttb_sim.io.topics import topic_table
 from ttb_sim.sim import Frame
 

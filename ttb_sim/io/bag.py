@@ -18,12 +18,12 @@ Recording frames to rosbag2 (MCAP or SQLite 3) with the rosbags library, a block
 :class:`BagRecorder` keeps the flat rows (:attr:`~ttb_sim.sim.Frame.row`) of the
 frames it is given and writes them a block at a time: the CDR bytes of every
 topic's messages for the whole block come from :class:`~ttb_sim.io.codec.BlockEncoder`
-(layouts learnt from the topic table's own builders). MCAP bags take the block
-as one array of message records (:class:`~ttb_sim.io.mcap_blocks.BlockWriter`);
-SQLite 3 bags get the same bytes message by message through rosbags' writer,
-whose SQLite storage takes one message per call. The messages, their order,
-stamps and bytes are those of the per-message path (``bulk=False``: each
-message built and serialised by rosbags), which stays as the reference.
+(layouts learnt from the topic table's own builders); MCAP bags take the block
+as one array of message records, SQLite 3 bags as one ``executemany``
+(:class:`~ttb_sim.io.block_storage.BlockWriter`: rosbags' writer with storages
+that take blocks). The messages, their order, stamps and bytes are those of
+the per-message path (``bulk=False``: each message built and serialised by
+rosbags, written by rosbags' own storages), which stays as the reference.
 """
 
 from __future__ import annotations
@@ -43,9 +43,9 @@ from rosbags.rosbag2 import StoragePlugin, Writer
 from rosbags.rosbag2.errors import WriterError
 from ttb_sim.errors import ScenarioError
 from ttb_sim.inputs import shown
+from ttb_sim.io.block_storage import BlockWriter, message_prefix, TIME_OFFSETS
 from ttb_sim.io.cdr import typestore
 from ttb_sim.io.codec import BlockEncoder, learn
-from ttb_sim.io.mcap_blocks import BlockWriter, message_prefix, TIME_OFFSETS
 from ttb_sim.io.topics import NAMESPACE, Topic
 from ttb_sim.sim import Frame
 
@@ -228,7 +228,7 @@ class BagRecorder:
         self._topics = list(topics)
         self._mcap = storage == 'mcap'
         self._bulk = bulk
-        writer = BlockWriter if bulk and self._mcap else Writer
+        writer = BlockWriter if bulk else Writer
         self._writer = writer(self.path, version=9, storage_plugin=STORAGES[storage])
         self._connections: list[Any] = []
         self._namespace = namespace
@@ -312,14 +312,10 @@ class BagRecorder:
             return
         stamps = self._stamps[:n].copy()
         records = self._encoder.encode(stamps, self._rows[:n])
-        if isinstance(self._writer, BlockWriter):
-            self._writer.write_frames(self._connections, records, self._encoder.starts, stamps)
-            return
-        spans = list(zip(self._connections, self._encoder.data_starts.tolist(),
-                         self._encoder.ends.tolist()))
-        for stamp, row in zip(stamps.tolist(), records):
-            for conn, start, end in spans:
-                self._writer.write(conn, stamp, row[start:end].tobytes())
+        assert isinstance(self._writer, BlockWriter)
+        starts = self._encoder.starts if self._mcap else self._encoder.data_starts
+        self._writer.write_frames(self._connections, records, starts, self._encoder.ends,
+                                  stamps)
 
     def close(self) -> None:
         """Write the frames kept, then close the bag (idempotent)."""

@@ -31,11 +31,15 @@ numpy index operations, each message optionally preceded by a record prefix
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any, Sequence
+from functools import lru_cache
+from typing import Any, Callable, Sequence
 
 import numpy as np
 
 from ttb_sim.io.topics import Topic
+
+Builder = Callable[..., Any]
+"""A topic's message builder: (types, stamp_ns, values) -> message."""
 
 _PROBE_SECONDS = (1_597_412_345, 1_308_642_075, 1_764_913_520)
 _PROBE_NANOSECONDS = (864_209_753, 123_456_789, 975_310_864)
@@ -101,12 +105,12 @@ def _find(data: np.ndarray, words: np.ndarray, size: int) -> np.ndarray:
     return found
 
 
-def _serializer(store: Any, topic: Topic) -> Any:
+def _serializer(store: Any, msgtype: str, build: Builder) -> Any:
     types = store.types.__getitem__
 
     def serialize(stamp_ns: int, values: np.ndarray) -> np.ndarray:
-        msg = topic.build(types, stamp_ns, values)
-        return np.frombuffer(bytes(store.serialize_cdr(msg, topic.msgtype)), dtype=np.uint8)
+        msg = build(types, stamp_ns, values)
+        return np.frombuffer(bytes(store.serialize_cdr(msg, msgtype)), dtype=np.uint8)
     return serialize
 
 
@@ -124,6 +128,9 @@ def learn(store: Any, topic: Topic) -> MessageCodec | None:
     """
     Learn a topic's CDR layout from its builder (None if it has no fixed layout).
 
+    Topics of one builder, type and number of values share their layout: it is
+    learnt once per type store (the arrays of a codec are read-only).
+
     Parameters
     ----------
     store : rosbags Typestore
@@ -139,12 +146,19 @@ def learn(store: Any, topic: Topic) -> MessageCodec | None:
         land at one place each): such a topic takes the per-message path.
 
     """
-    serialize = _serializer(store, topic)
-    k = len(topic.columns)
+    return _learn(store, topic.msgtype, topic.build, len(topic.columns))
+
+
+@lru_cache(maxsize=256)
+def _learn(store: Any, msgtype: str, build: Builder, k: int) -> MessageCodec | None:
+    serialize = _serializer(store, msgtype, build)
     template = serialize(0, np.zeros(k))
+    probe = Topic('probe', msgtype, (), tuple(range(k)), build)   # a column per value
     for attempt in range(len(_PROBE_SECONDS) - 1):
         codec = _locate(serialize, template, k, attempt)
-        if codec is not None and _verified(serialize, topic, codec, attempt + 1):
+        if codec is not None and _verified(serialize, probe, codec, attempt + 1):
+            for array in (codec.template, codec.offsets, codec.float32):
+                array.setflags(write=False)
             return codec
     return None
 
@@ -165,13 +179,13 @@ def _locate(serialize: Any, template: np.ndarray, k: int, seed: int) -> MessageC
     return MessageCodec(template, None if stamp < 0 else int(stamp), offsets, float32)
 
 
-def _verified(serialize: Any, topic: Topic, codec: MessageCodec, seed: int) -> bool:
-    """Whether the codec composes the builder's bytes for a fresh probe, negative values too."""
+def _verified(serialize: Any, probe: Topic, codec: MessageCodec, seed: int) -> bool:
+    """Whether the codec composes the builder's bytes for fresh values, negative ones too."""
     stamp_ns = _PROBE_SECONDS[seed] * _NS + _PROBE_NANOSECONDS[seed]
-    row = np.zeros((1, int(topic.index.max(initial=0)) + 1))
-    row[0] = _probe(row.shape[1], seed) * np.where(np.arange(row.shape[1]) % 2, -3.0, 5.0)
-    want = serialize(stamp_ns, row[0, topic.index])   # (a column may serve twice)
-    got = BlockEncoder([topic], [codec]).encode(np.array([stamp_ns]), row)
+    k = len(probe.columns)
+    values = _probe(k, seed) * np.where(np.arange(k) % 2, -3.0, 5.0)
+    want = serialize(stamp_ns, values)
+    got = BlockEncoder([probe], [codec]).encode(np.array([stamp_ns]), values[None, :])
     return got.shape == (1, len(want)) and bool(np.all(got[0] == want))
 
 
@@ -180,7 +194,10 @@ class BlockEncoder:
     The messages of every topic of a table for a block of frames, as rows of bytes.
 
     Row ``k`` holds, for every topic in order, its optional record prefix then
-    its CDR message for frame ``k``.
+    its CDR message for frame ``k``. A row is the template of constant bytes
+    with, at fixed offsets, each topic's values (float64 or float32), its stamp
+    and the prefix's times: one structured numpy view of the rows receives all
+    of them from one packed array per block.
 
     Parameters
     ----------
@@ -199,37 +216,36 @@ class BlockEncoder:
                  prefixes: Sequence[bytes] | None = None,
                  time_offsets: Sequence[int] = ()) -> None:
         prefixes = prefixes or [b''] * len(codecs)
-        pieces, starts, ends = [], [], []
-        f8_dst, f8_col, f4_dst, f4_col, stamp_dst, time_dst = [], [], [], [], [], []
+        pieces, starts, data_starts = [], [], []
+        places: dict[str, list[np.ndarray]] = {'f8': [], 'f4': [], 'stamp': [], 'time': []}
+        f8_col, f4_col = [], []
         position = 0
         for topic, codec, prefix in zip(topics, codecs, prefixes):
             starts.append(position)
             pieces += [np.frombuffer(prefix, dtype=np.uint8), codec.template]
-            time_dst += [position + t for t in time_offsets]
+            places['time'].append(position + np.asarray(time_offsets, dtype=np.int64))
             position += len(prefix)
+            data_starts.append(position)
             if codec.stamp is not None:
-                stamp_dst.append(position + codec.stamp)
-            columns = topic.index
-            f8_dst.append(position + codec.offsets[~codec.float32])
-            f8_col.append(columns[~codec.float32])
-            f4_dst.append(position + codec.offsets[codec.float32])
-            f4_col.append(columns[codec.float32])
+                places['stamp'].append(np.array([position + codec.stamp]))
+            places['f8'].append(position + codec.offsets[~codec.float32])
+            places['f4'].append(position + codec.offsets[codec.float32])
+            f8_col.append(topic.index[~codec.float32])
+            f4_col.append(topic.index[codec.float32])
             position += len(codec.template)
-            ends.append(position)
         self.template = np.concatenate(pieces) if pieces else np.zeros(0, dtype=np.uint8)
         self.starts = np.asarray(starts, dtype=np.int64)
         """Byte offset of each topic's record (its prefix) in a row."""
-        self.ends = np.asarray(ends, dtype=np.int64)
-        """Byte offset just past each topic's message in a row."""
-        self.data_starts = self.ends - np.array([len(c.template) for c in codecs], dtype=np.int64)
+        self.data_starts = np.asarray(data_starts, dtype=np.int64)
         """Byte offset of each topic's CDR message in a row."""
-        self._f8 = np.concatenate(f8_col or [np.zeros(0, np.intp)]).astype(np.intp)
-        self._f4 = np.concatenate(f4_col or [np.zeros(0, np.intp)]).astype(np.intp)
-        self._scatter, self._gather = _plan(
-            [np.concatenate(f8_dst or [np.zeros(0, np.int64)]),
-             np.concatenate(f4_dst or [np.zeros(0, np.int64)]),
-             np.asarray(stamp_dst, dtype=np.int64), np.asarray(time_dst, dtype=np.int64)],
-            len(self._f8), len(self._f4))
+        self.ends = self.data_starts + [len(c.template) for c in codecs]
+        """Byte offset just past each topic's message in a row."""
+        self._f8 = _joined(f8_col).astype(np.intp)
+        self._f4 = _joined(f4_col).astype(np.intp)
+        self._stamps = len(_joined(places['stamp']))
+        self._times = self._stamps + len(_joined(places['time']))
+        self._destination, self._source = _views(
+            {name: _joined(offsets) for name, offsets in places.items()}, self.width)
 
     @property
     def width(self) -> int:
@@ -251,30 +267,35 @@ class BlockEncoder:
         n = len(stamps)
         with np.errstate(over='ignore'):   # beyond float32: inf, as the builders give
             single = np.take(rows, self._f4, axis=1).astype('<f4')
-        source = np.concatenate([
-            np.take(rows, self._f8, axis=1).view(np.uint8).reshape(n, -1),
-            single.view(np.uint8).reshape(n, -1),
-            _stamp_bytes(stamps),
-            np.asarray(stamps, dtype='<u8').view(np.uint8).reshape(n, 8)], axis=1)
+        times = np.empty((n, self._times), dtype='<u8')   # the stamps, then the record times
+        times[:, :self._stamps] = _stamp_bytes(stamps).view('<u8')
+        times[:, self._stamps:] = np.asarray(stamps, dtype='<u8')[:, None]
+        source = np.concatenate([np.take(rows, self._f8, axis=1).view(np.uint8).reshape(n, -1),
+                                 single.view(np.uint8).reshape(n, -1),
+                                 times.view(np.uint8).reshape(n, -1)], axis=1)
         out = np.tile(self.template, (n, 1))
-        out[:, self._scatter] = source[:, self._gather]
+        out.view(self._destination)[:, 0] = source.view(self._source)[:, 0]
         return out
 
 
-def _plan(destinations: list[np.ndarray], n8: int, n4: int) -> tuple[np.ndarray, np.ndarray]:
-    """
-    Return the byte destinations in a row and their source bytes in the encoder's source.
+def _joined(parts: Sequence[np.ndarray]) -> np.ndarray:
+    return np.concatenate(parts) if parts else np.zeros(0, dtype=np.int64)
 
-    ``destinations`` are the byte offsets of the float64 values, the float32
-    values, the stamps (8 bytes each, all from one stamp) and the uint64 times.
+
+def _views(places: dict[str, np.ndarray], width: int) -> tuple[np.dtype, np.dtype]:
     """
-    f8, f4, stamps, times = destinations
-    stamp_source, time_source = 8 * n8 + 4 * n4, 8 * n8 + 4 * n4 + 8
-    scatter = np.concatenate([(f8[:, None] + np.arange(8)).ravel(),
-                              (f4[:, None] + np.arange(4)).ravel(),
-                              (stamps[:, None] + np.arange(8)).ravel(),
-                              (times[:, None] + np.arange(8)).ravel()])
-    gather = np.concatenate([np.arange(8 * n8), 8 * n8 + np.arange(4 * n4),
-                             np.tile(stamp_source + np.arange(8), len(stamps)),
-                             np.tile(time_source + np.arange(8), len(times))])
-    return scatter.astype(np.intp), gather.astype(np.intp)
+    Return the structured dtypes of a row's variable fields and of their packed source.
+
+    ``places`` are the byte offsets in a row of the float64 values, the float32
+    values, the stamps and the uint64 times, in the order of the packed source
+    (which :meth:`BlockEncoder.encode` fills in that order); every field is an
+    unsigned integer, so that bytes are copied as they are (NaN payloads too).
+    """
+    offsets, formats = [], []
+    for name, size in (('f8', 8), ('f4', 4), ('stamp', 8), ('time', 8)):
+        offsets += places[name].tolist()
+        formats += [f'<u{size}'] * len(places[name])
+    names = [f'v{i}' for i in range(len(offsets))]
+    destination = np.dtype({'names': names, 'formats': formats, 'offsets': offsets,
+                            'itemsize': width})
+    return destination, np.dtype({'names': names, 'formats': formats})

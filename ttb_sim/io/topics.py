@@ -281,17 +281,23 @@ class PeakTracker:
 
     def update(self, frame: Frame) -> None:
         """Fold one frame into the running extremes."""
-        self.update_rows(frame.row[None, :])
+        row = frame.row
+        if self._lo is None or self._hi is None:
+            self._lo, self._hi = row.copy(), row.copy()
+            return
+        np.minimum(self._lo, row, out=self._lo)
+        np.maximum(self._hi, row, out=self._hi)
 
     def update_rows(self, rows: np.ndarray) -> None:
         """Fold the flat rows ``(frames, width)`` of some frames into the running extremes."""
         if not len(rows):
             return
+        lo, hi = np.min(rows, axis=0), np.max(rows, axis=0)
         if self._lo is None or self._hi is None:
-            self._lo = np.full(rows.shape[1], np.inf)
-            self._hi = np.full(rows.shape[1], -np.inf)
-        np.minimum(self._lo, np.min(rows, axis=0), out=self._lo)
-        np.maximum(self._hi, np.max(rows, axis=0), out=self._hi)
+            self._lo, self._hi = lo, hi
+            return
+        np.minimum(self._lo, lo, out=self._lo)
+        np.maximum(self._hi, hi, out=self._hi)
 
     def summary(self) -> dict[str, dict[str, dict[str, float]]]:
         """Return {topic: {field: {min, max, abs_max}}} (fields never seen are omitted)."""

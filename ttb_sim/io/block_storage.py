@@ -13,12 +13,15 @@
 # limitations under the License.
 
 """
-MCAP storage for rosbags' rosbag2 writer that takes messages a block of frames at a time.
+Storages for rosbags' rosbag2 writer that take the messages of a block of frames at once.
 
 rosbags' :class:`~rosbags.rosbag2.Writer` keeps doing what it does well: the
 connections, message definitions and type hashes, the QoS text, the counts and
-``metadata.yaml``. :class:`BlockWriter` only swaps its MCAP storage for
-:class:`McapBlockStorage`, which writes the file rosbags' own MCAP storage
+``metadata.yaml``. :class:`BlockWriter` only swaps its storages for ones with a
+``write_frames`` of many frames' messages (:class:`~ttb_sim.io.codec.BlockEncoder`
+rows). :class:`SqliteBlockStorage` is rosbags' own SQLite storage, inserting a
+block with one ``executemany`` of rosbags' own statement. :class:`McapBlockStorage`
+writes the file rosbags' own MCAP storage
 writes (profile ``ros2``, schema encoding ``ros2msg``, message encoding
 ``cdr``, the ``offered_qos_profiles`` channel metadata, schemas and channels at
 the head of the first chunk, uncompressed chunks closed after the message
@@ -28,9 +31,9 @@ CRCs left 0) but takes the message records of many frames as one byte array
 (:class:`~ttb_sim.io.codec.BlockEncoder`) and indexes them with numpy. Only
 the file's ``library`` field differs: it names ttb_sim.
 
-Neither rosbags' storage nor the ``mcap`` library's writer takes more than one
-message per call, and at about 7-9 microseconds a message either cost more
-than the whole physics of a run of ours.
+Neither rosbags' MCAP storage nor the ``mcap`` library's writer takes more
+than one message per call, and at about 7-9 microseconds a message (measured)
+either cost more than the whole physics of a run of ours.
 """
 
 from __future__ import annotations
@@ -44,6 +47,7 @@ from rosbags.interfaces import Connection, ConnectionExtRosbag2, MessageDefiniti
 from rosbags.rosbag2 import StoragePlugin, Writer
 from rosbags.rosbag2.enums import CompressionMode
 from rosbags.rosbag2.errors import WriterError
+from rosbags.rosbag2.storage_sqlite3 import Sqlite3Writer
 
 from ttb_sim import __version__
 
@@ -160,6 +164,31 @@ class McapBlockStorage:
         self.write_records(np.frombuffer(bytes(record), dtype=np.uint8), np.array([0]),
                            np.array([connection.id]), np.array([timestamp]))
 
+    def write_frames(self, ids: np.ndarray, records: np.ndarray, starts: np.ndarray,
+                     ends: np.ndarray, stamps: np.ndarray) -> None:
+        """
+        Write the message records of a block of frames, frame after frame.
+
+        Parameters
+        ----------
+        ids : numpy.ndarray
+            ``(topics,)`` the channel of each record of a frame.
+        records : numpy.ndarray
+            ``(frames, bytes)`` uint8: per frame, one MCAP message record
+            (:func:`message_prefix` then CDR) per channel, end to end.
+        starts, ends : numpy.ndarray
+            ``(topics,)`` where each record begins and ends in a row.
+        stamps : numpy.ndarray
+            ``(frames,)`` each frame's log time (ns), as written in its records.
+
+        """
+        n, width = records.shape
+        if n and (starts[0] != 0 or ends[-1] != width or np.any(starts[1:] != ends[:-1])):
+            raise WriterError('MCAP message records of a frame must lie end to end')
+        at = (np.arange(n, dtype=np.int64)[:, None] * width + starts[None, :]).ravel()
+        self.write_records(records.reshape(-1), at, np.tile(ids, n),
+                           np.repeat(stamps, len(ids)))
+
     def write_records(self, stream: np.ndarray, starts: np.ndarray, channels: np.ndarray,
                       times: np.ndarray) -> None:
         """
@@ -220,23 +249,33 @@ class McapBlockStorage:
             + _u64(chunk.size) + _u64(chunk.size))
 
     def _message_indexes(self, chunk: _Chunk) -> list[tuple[int, int]]:
-        """Write one message index per channel (in order of first message); return where."""
+        """
+        Write one message index per channel (in order of first message); return where.
+
+        The offsets returned are relative to the first message index record.
+        """
         if not chunk.channels:
             return []
         channels = np.concatenate(chunk.channels)
-        entries = np.stack([np.concatenate(chunk.times), np.concatenate(chunk.offsets)],
-                           axis=1).astype('<u8')
         ids, first, counts = np.unique(channels, return_index=True, return_counts=True)
-        order = np.argsort(channels, kind='stable')
-        bounds = np.searchsorted(channels[order], ids)
-        where = []
-        at = self.bio.tell()
-        for k in np.argsort(first):
-            rows = order[bounds[k]:bounds[k] + counts[k]]
-            body = entries[rows].tobytes()
-            record = _record(0x07, _u16(int(ids[k])) + _u32(len(body)) + body)
-            where.append((int(ids[k]), self.bio.tell() - at))
-            self.bio.write(record)
+        sequence = np.argsort(first)               # the channels by their first message
+        rank = np.empty_like(sequence)
+        rank[sequence] = np.arange(len(sequence))
+        order = np.argsort(rank[np.searchsorted(ids, channels)], kind='stable')
+        entries = np.empty((len(channels), 2), dtype='<u8')
+        entries[:, 0] = np.concatenate(chunk.times)[order]
+        entries[:, 1] = np.concatenate(chunk.offsets)[order]
+        data = entries.view(np.uint8).reshape(-1)
+        pieces: list[Any] = []
+        where, at, done = [], 0, 0
+        for k in sequence.tolist():
+            body = 16 * int(counts[k])
+            header = bytes((0x07,)) + _u64(6 + body) + _u16(int(ids[k])) + _u32(body)
+            pieces += [header, data[done:done + body]]
+            where.append((int(ids[k]), at))
+            at += len(header) + body
+            done += body
+        self.bio.write(b''.join(pieces))
         return where
 
     def close(self, version: int, metadata: str) -> None:
@@ -281,37 +320,69 @@ class McapBlockStorage:
         self.bio.close()
 
 
-class BlockWriter(Writer):
-    """rosbags' rosbag2 writer whose MCAP storage takes blocks of message records."""
+class SqliteBlockStorage(Sqlite3Writer):
+    """rosbags' SQLite 3 storage, inserting the messages of a block of frames at once."""
 
-    STORAGE_PLUGINS = {**Writer.STORAGE_PLUGINS, StoragePlugin.MCAP: McapBlockStorage}
+    INSERT = 'INSERT INTO messages (topic_id, timestamp, data) VALUES(?, ?, ?)'
+    """rosbags' own statement for a message (rosbag2's ``messages`` table)."""
+
+    def write_frames(self, ids: np.ndarray, records: np.ndarray, starts: np.ndarray,
+                     ends: np.ndarray, stamps: np.ndarray) -> None:
+        """
+        Insert the messages of a block of frames, frame after frame, topic after topic.
+
+        Parameters
+        ----------
+        ids : numpy.ndarray
+            ``(topics,)`` the topic id of each message of a frame.
+        records : numpy.ndarray
+            ``(frames, bytes)`` uint8 rows holding the messages.
+        starts, ends : numpy.ndarray
+            ``(topics,)`` where each CDR message begins and ends in a row.
+        stamps : numpy.ndarray
+            ``(frames,)`` each frame's time stamp (ns).
+
+        """
+        n, width = records.shape
+        flat = np.ascontiguousarray(records).reshape(-1).data
+        base = np.arange(n, dtype=np.int64)[:, None] * width
+        slices = map(slice, (base + starts).ravel().tolist(), (base + ends).ravel().tolist())
+        self.cursor.executemany(self.INSERT, zip(np.tile(ids, n).tolist(),
+                                                 np.repeat(stamps, len(ids)).tolist(),
+                                                 map(flat.__getitem__, slices)))
+
+
+class BlockWriter(Writer):
+    """rosbags' rosbag2 writer whose storages take the messages of blocks of frames."""
+
+    STORAGE_PLUGINS = {StoragePlugin.SQLITE3: SqliteBlockStorage,
+                       StoragePlugin.MCAP: McapBlockStorage}
 
     def write_frames(self, connections: Sequence[Connection], records: np.ndarray,
-                     starts: np.ndarray, stamps: np.ndarray) -> None:
+                     starts: np.ndarray, ends: np.ndarray, stamps: np.ndarray) -> None:
         """
-        Write the message records of a block of frames, frame after frame.
+        Write the messages of a block of frames, frame after frame, connection after connection.
 
         Parameters
         ----------
         connections : sequence of Connection
-            The connection of each record of a frame, in order.
+            The connection of each message of a frame, in order.
         records : numpy.ndarray
-            ``(frames, bytes)`` uint8: per frame, one MCAP message record
-            (:func:`message_prefix` then CDR) per connection, end to end.
-        starts : numpy.ndarray
-            Offset of each connection's record in a frame's row, increasing.
+            ``(frames, bytes)`` uint8 rows: what the storage stores of each
+            message of a frame (for MCAP the whole message records, end to end;
+            for SQLite 3 the CDR messages).
+        starts, ends : numpy.ndarray
+            ``(connections,)`` where each connection's part begins and ends in a row.
         stamps : numpy.ndarray
-            ``(frames,)`` each frame's time stamp (ns), as written in its records.
+            ``(frames,)`` each frame's time stamp (ns).
 
         """
         storage = self.storage
-        if not isinstance(storage, McapBlockStorage):
-            raise WriterError('the bag is not open with the block MCAP storage')
-        n, width = records.shape
+        if not isinstance(storage, (McapBlockStorage, SqliteBlockStorage)):
+            raise WriterError('the bag is not open with a block storage')
         ids = np.array([c.id for c in connections], dtype=np.int64)
-        at = (np.arange(n, dtype=np.int64)[:, None] * width + starts[None, :]).ravel()
-        storage.write_records(records.reshape(-1), at, np.tile(ids, n),
-                              np.repeat(stamps, len(ids)))
+        storage.write_frames(ids, records, starts, ends, stamps)
+        n = len(stamps)
         for connection in connections:
             self.counts[connection.id] += n
         if n:
