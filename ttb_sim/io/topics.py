@@ -20,7 +20,11 @@ typestore) and the live node (messages built from the rclpy classes): a
 conversion receives a ``types`` callable that maps a type name such as
 ``'geometry_msgs/msg/Vector3Stamped'`` to a message class, and builds the message
 with keyword arguments named exactly as the ROS fields. Every field is given, so
-the same call works for both back-ends.
+the same call works for both back-ends. A topic reads its numbers from the
+frame's flat row (:attr:`~ttb_sim.sim.Frame.row`) at its ``columns``, so that
+the values of many frames and topics are gathered with one index; the
+builders stay the one definition of each message, and the bags' bulk CDR
+layouts are learnt from them (:mod:`ttb_sim.io.codec`).
 """
 
 from __future__ import annotations
