@@ -129,13 +129,17 @@ def test_mcap_summary_and_messages_with_the_mcap_reader(bags):
     assert messages == ref_messages
 
 
-def test_mcap_file_is_rosbags_own_but_for_the_library_field(bags, tmp_path: Path,
-                                                            monkeypatch):
+@pytest.mark.parametrize('count', [0, 1, FRAMES])
+def test_mcap_file_is_rosbags_own_but_for_the_library_field(tmp_path: Path, monkeypatch,
+                                                            count: int):
     """Written with rosbags' library name, the file is the very bytes rosbags writes."""
+    items = frames(count)
+    ref = _write(tmp_path / 'ref' / 'bag', 'mcap', False, items)
     monkeypatch.setattr(McapBlockStorage, 'LIBRARY', f'rosbags-{version("rosbags")}')
     monkeypatch.setattr(bag_module, 'MAX_BLOCK_FRAMES', 13)
-    ours = _write(tmp_path / 'mcap-False' / 'bag', 'mcap', True)
-    assert (ours / 'bag.mcap').read_bytes() == (bags['mcap', False] / 'bag.mcap').read_bytes()
+    ours = _write(tmp_path / 'ours' / 'bag', 'mcap', True, items)
+    assert (ours / 'bag.mcap').read_bytes() == (ref / 'bag.mcap').read_bytes()
+    assert (ours / 'metadata.yaml').read_text() == (ref / 'metadata.yaml').read_text()
 
 
 def test_mcap_ros2_decodes_every_message_to_the_frames_values(bags):
