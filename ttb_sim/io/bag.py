@@ -235,9 +235,10 @@ class BagRecorder:
         self.messages = 0
         self._open = False
         self._encoder: BlockEncoder | None = None
-        self._rows = np.zeros((0, 0))
-        self._stamps = np.zeros(0, dtype=np.int64)
-        self._kept = 0
+        self._rows: list[np.ndarray] = []     # the flat rows of the frames kept
+        self._stamps: list[int] = []
+        self._width = -1                      # values per frame (-1: no frame yet)
+        self._capacity = 1                    # frames per block
 
     def __enter__(self) -> BagRecorder:
         """Open the bag and register one connection per topic."""
@@ -283,39 +284,37 @@ class BagRecorder:
 
     def _keep(self, frame: Frame) -> None:
         row = frame.row
-        if not self._kept:
-            self._allocate(row.size)
-        if row.size != self._rows.shape[1]:
-            raise ValueError(f'frame at t = {frame.time:g} s has {row.size} values; the frames '
-                             f'before it had {self._rows.shape[1]}')
-        self._rows[self._kept] = row
-        self._stamps[self._kept] = frame.stamp_ns
-        self._kept += 1
-        if self._kept == len(self._stamps):
+        if row.size != self._width:
+            self._set_width(row.size, frame.time)
+        self._rows.append(row)
+        self._stamps.append(frame.stamp_ns)
+        if len(self._rows) == self._capacity:
             self.flush()
 
-    def _allocate(self, width: int) -> None:
-        """Make the block's buffers for frames of ``width`` values (once, or on a new width)."""
+    def _set_width(self, width: int, time: float) -> None:
+        """Take the number of values of the first frame (and size the blocks by it)."""
         assert self._encoder is not None
+        if self._width >= 0:
+            raise ValueError(f'frame at t = {time:g} s has {width} values; the frames '
+                             f'before it had {self._width}')
         needed = max((int(t.index.max(initial=0)) for t in self._topics), default=0) + 1
         if width < needed:
             raise ValueError(f'a frame has {width} values; the topic table reads {needed}')
-        if self._rows.shape[1] != width:
-            frames = max(1, min(MAX_BLOCK_FRAMES, BLOCK_BYTES // max(self._encoder.width, 1)))
-            self._rows = np.zeros((frames, width))
-            self._stamps = np.zeros(frames, dtype=np.int64)
+        self._width = width
+        self._capacity = max(1, min(MAX_BLOCK_FRAMES,
+                                    BLOCK_BYTES // max(self._encoder.width, 1)))
 
     def flush(self) -> None:
         """Write the frames kept for the block so far."""
-        n, self._kept = self._kept, 0
-        if not n or self._encoder is None:
+        rows, stamps, self._rows, self._stamps = self._rows, self._stamps, [], []
+        if not rows or self._encoder is None:
             return
-        stamps = self._stamps[:n].copy()
-        records = self._encoder.encode(stamps, self._rows[:n])
+        times = np.array(stamps, dtype=np.int64)
+        records = self._encoder.encode(times, np.stack(rows))
         assert isinstance(self._writer, BlockWriter)
         starts = self._encoder.starts if self._mcap else self._encoder.data_starts
         self._writer.write_frames(self._connections, records, starts, self._encoder.ends,
-                                  stamps)
+                                  times)
 
     def close(self) -> None:
         """Write the frames kept, then close the bag (idempotent)."""

@@ -162,13 +162,11 @@ class Frame:
         ``row[0]`` is 0.0 (:data:`ZERO_COLUMN`); then the fields of :data:`ROW_FIELDS`,
         each raveled in C order; :meth:`Layout.columns` maps them.
         """
-        return np.concatenate(   # in ROW_FIELDS order
-            (np.array((0.0, self.head_position, self.speed)), self.midspan.reshape(-1),
-             self.bearings.reshape(-1), self.body_acceleration.reshape(-1),
-             self.body_angular_velocity.reshape(-1), self.wheel_rail.reshape(-1),
-             self.observers.reshape(-1), self.pile_displacement.reshape(-1),
-             self.pile_acceleration.reshape(-1), self.pile_rotation_rate.reshape(-1),
-             self.soil_points.reshape(-1)), dtype=np.float64)
+        return np.concatenate(   # in ROW_FIELDS order; axis None ravels each
+            ((0.0, self.head_position, self.speed), self.midspan, self.bearings,
+             self.body_acceleration, self.body_angular_velocity, self.wheel_rail,
+             self.observers, self.pile_displacement, self.pile_acceleration,
+             self.pile_rotation_rate, self.soil_points), axis=None, dtype=np.float64)
 
     @property
     def stamp_ns(self) -> int:
