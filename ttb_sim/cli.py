@@ -57,7 +57,8 @@ def _add_model_verbs(sub: Any) -> None:
     """Add the verbs that build a scenario's model: run, validate, bench, modes."""
     run = sub.add_parser('run', help='simulate a scenario and record a rosbag2')
     run.add_argument('scenario', help='YAML path or built-in name (see `ttb-sim scenarios`)')
-    run.add_argument('--out', type=Path, help='bag directory to create (default: a new '
+    # A str, not a Path: Path('') is '.', and an empty --out must be named as empty.
+    run.add_argument('--out', help='bag directory to create (default: a new '
                      'folder under ./runs/)')
     run.add_argument('--speed-kmh', type=float, help='override train.speed_kmh')
     run.add_argument('--duration', type=float, help='override solver.duration (s)')

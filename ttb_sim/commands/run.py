@@ -54,7 +54,7 @@ class RunResult:
     summary: dict[str, Any]
 
 
-def run_to_bag(scenario: Scenario, out: Path, storage: str = 'mcap',
+def run_to_bag(scenario: Scenario, out: str | Path, storage: str = 'mcap',
                progress: Callable[[int], None] | None = None,
                simulation: Runner | None = None,
                should_stop: Callable[[], bool] | None = None,
@@ -98,8 +98,8 @@ def run_to_bag(scenario: Scenario, out: Path, storage: str = 'mcap',
         Re-raised after the bag and summary have been closed and written.
 
     """
-    out = Path(out)
     check_destination(out, storage)  # before summary.json could land in someone's folder
+    out = Path(out)
     built = time.perf_counter()
     sim = simulation or make_runner(scenario)
     setup_time += time.perf_counter() - built
@@ -171,7 +171,7 @@ def _summary(scenario: Scenario, sim: Runner, out: Path, storage: str, topics: S
     }
 
 
-def run(scenario: str | Path, *, out: Path | None = None, storage: str = 'mcap',
+def run(scenario: str | Path, *, out: str | Path | None = None, storage: str = 'mcap',
         overrides: Sequence[str] = (), speed_kmh: float | None = None,
         duration: float | None = None, force: bool = False) -> int:
     """
@@ -237,7 +237,7 @@ def run(scenario: str | Path, *, out: Path | None = None, storage: str = 'mcap',
     return EXIT_OK
 
 
-def _set_up(scenario: str | Path, out: Path | None, storage: str, overrides: Sequence[str],
+def _set_up(scenario: str | Path, out: str | Path | None, storage: str, overrides: Sequence[str],
             speed_kmh: float | None, duration: float | None, force: bool
             ) -> tuple[Scenario, Path, Runner]:
     """Load the scenario, check the destination, then build the model (in that order)."""
@@ -247,7 +247,7 @@ def _set_up(scenario: str | Path, out: Path | None, storage: str, overrides: Seq
     if duration is not None:
         values.append(('solver.duration', duration))
     loaded = load_scenario(scenario, overrides, values)
-    out = Path(out) if out is not None else default_bag_path(loaded.name)
-    check_destination(out, storage)  # before the model is built: a bad --out fails at once
+    target = out if out is not None else default_bag_path(loaded.name)
+    check_destination(target, storage)  # before the model is built: a bad --out fails at once
     log.info('set-up: building the model of %s', loaded.name)
-    return loaded, out, make_runner(loaded, max_steps=None if force else STEP_BUDGET)
+    return loaded, Path(target), make_runner(loaded, max_steps=None if force else STEP_BUDGET)

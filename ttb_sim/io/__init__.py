@@ -16,7 +16,9 @@
 Input and output: the topic table, the rosbag2 recorder, the bag reader and the bag's streams.
 
 ``topics`` maps frames to standard ROS 2 messages (one table for the node and the
-bags), ``bag`` records frames to rosbag2 (MCAP or SQLite 3), ``reader`` reads any
+bags), ``bag`` records frames to rosbag2 (MCAP or SQLite 3) a block of frames at a
+time, with the CDR layouts ``codec`` learns from the table's builders and the
+block storages of ``block_storage`` under rosbags' writer; ``reader`` reads any
 bag of ours back into numpy arrays per topic, ``streams`` sorts those arrays into
 named, evenly sampled streams (car bodies, wheel-rail forces, girders, piles, soil)
 for the reports.

@@ -12,10 +12,24 @@
 # See the License for the specific language governing permissions and
 # limitations under the License.
 
-"""Recording frames to rosbag2 (MCAP or SQLite 3) with the rosbags library."""
+"""
+Recording frames to rosbag2 (MCAP or SQLite 3) with the rosbags library, a block at a time.
+
+:class:`BagRecorder` keeps the flat rows (:attr:`~ttb_sim.sim.Frame.row`) of the
+frames it is given and writes them a block at a time: the CDR bytes of every
+topic's messages for the whole block come from :class:`~ttb_sim.io.codec.BlockEncoder`
+(layouts learnt from the topic table's own builders); MCAP bags take the block
+as one array of message records, SQLite 3 bags as one ``executemany``
+(:class:`~ttb_sim.io.block_storage.BlockWriter`: rosbags' writer with storages
+that take blocks). The messages, their order, stamps and bytes are those of
+the per-message path (``bulk=False``: each message built and serialised by
+rosbags, written by rosbags' own storages), which stays as the reference.
+"""
 
 from __future__ import annotations
 
+import errno
+import logging
 import os
 from pathlib import Path
 import signal
@@ -24,16 +38,27 @@ import time
 from types import TracebackType
 from typing import Any, Sequence
 
+import numpy as np
 from rosbags.rosbag2 import StoragePlugin, Writer
 from rosbags.rosbag2.errors import WriterError
 from ttb_sim.errors import ScenarioError
 from ttb_sim.inputs import shown
+from ttb_sim.io.block_storage import BlockWriter, message_prefix, TIME_OFFSETS
 from ttb_sim.io.cdr import typestore
+from ttb_sim.io.codec import BlockEncoder, learn
 from ttb_sim.io.topics import NAMESPACE, Topic
 from ttb_sim.sim import Frame
 
+log = logging.getLogger(__name__)
+
 STORAGES = {'mcap': StoragePlugin.MCAP, 'sqlite3': StoragePlugin.SQLITE3}
 """Storage back-ends by their rosbag2 plugin names."""
+BLOCK_BYTES = 4 * 2 ** 20
+"""About how many bytes of messages a block of frames holds before it is written."""
+MAX_BLOCK_FRAMES = 512
+"""The most frames a block holds (a live node's bag gets them at most this late)."""
+_REASONS = {errno.EROFS: 'read-only file system', errno.EACCES: 'permission denied',
+            errno.EPERM: 'permission denied'}
 
 
 def check_destination(path: str | Path, storage: str, option: str = '--out') -> None:
@@ -64,6 +89,9 @@ def check_destination(path: str | Path, storage: str, option: str = '--out') -> 
     """
     if storage not in STORAGES:
         raise ScenarioError(f'storage {shown(storage)}: allowed values are {", ".join(STORAGES)}')
+    if isinstance(path, str) and not path:
+        raise ScenarioError(f'output directory path is empty (give a folder to create with '
+                            f'{option})')
     out = Path(path)
     name = shown(str(path))
     if out.exists() or out.is_symlink():
@@ -83,9 +111,12 @@ def check_destination(path: str | Path, storage: str, option: str = '--out') -> 
         raise ScenarioError(f'output directory {name} is inside {shown(str(ancestor))}, which '
                             'is a file, not a directory')
     what = 'parent directory' if ancestor == absolute.parent else 'nearest existing folder'
-    problem = None if os.access(ancestor, os.W_OK | os.X_OK) else 'permission denied'
-    if problem is None:  # access() says yes to root even on /proc or a read-only mount
-        problem = _probe(ancestor)
+    # access() says yes to root even on /proc or a read-only mount, and says no without
+    # telling why: the probe tells (a read-only file system, or no permission)
+    denied = not os.access(ancestor, os.W_OK | os.X_OK)
+    problem = _probe(ancestor)
+    if problem is None and denied:
+        problem = 'permission denied'
     if problem is not None:
         raise ScenarioError(f'output directory {name} cannot be created: the {what} '
                             f'{shown(str(ancestor))} is not writable ({problem})')
@@ -105,7 +136,7 @@ def _probe(folder: Path) -> str | None:
     try:
         os.rmdir(tempfile.mkdtemp(prefix='.ttb_sim-probe-', dir=folder))
     except OSError as exc:
-        return (exc.strerror or str(exc)).lower()
+        return _REASONS.get(exc.errno or 0, (exc.strerror or str(exc)).lower())
     finally:
         if mask:
             signal.pthread_sigmask(signal.SIG_UNBLOCK, held)
@@ -162,7 +193,9 @@ class BagRecorder:
     Write frames as messages of a topic table into a new rosbag2 directory.
 
     Use as a context manager: the bag is closed (and so readable) however the
-    block ends, including on KeyboardInterrupt.
+    block ends, including on KeyboardInterrupt. Frames are kept and written a
+    block at a time (:data:`BLOCK_BYTES`, at most :data:`MAX_BLOCK_FRAMES`);
+    :meth:`flush` writes those kept so far, :meth:`close` writes them and closes.
 
     Parameters
     ----------
@@ -174,6 +207,10 @@ class BagRecorder:
         'mcap' (default) or 'sqlite3'.
     namespace : str
         Namespace of the private topics.
+    bulk : bool
+        True (default): serialise blocks of frames with learnt layouts; False:
+        build and serialise every message with rosbags (the reference path,
+        also taken when a topic's layout cannot be learnt).
 
     Raises
     ------
@@ -183,17 +220,25 @@ class BagRecorder:
     """
 
     def __init__(self, path: str | Path, topics: Sequence[Topic], storage: str = 'mcap',
-                 namespace: str = NAMESPACE) -> None:
+                 namespace: str = NAMESPACE, bulk: bool = True) -> None:
         check_destination(path, storage)
         self.path = Path(path)
         self._store = typestore()
         self._types = self._store.types.__getitem__
         self._topics = list(topics)
-        self._writer = Writer(self.path, version=9, storage_plugin=STORAGES[storage])
+        self._mcap = storage == 'mcap'
+        self._bulk = bulk
+        writer = BlockWriter if bulk else Writer
+        self._writer = writer(self.path, version=9, storage_plugin=STORAGES[storage])
         self._connections: list[Any] = []
         self._namespace = namespace
         self.messages = 0
         self._open = False
+        self._encoder: BlockEncoder | None = None
+        self._rows: list[np.ndarray] = []     # the flat rows of the frames kept
+        self._stamps: list[int] = []
+        self._width = -1                      # values per frame (-1: no frame yet)
+        self._capacity = 1                    # frames per block
 
     def __enter__(self) -> BagRecorder:
         """Open the bag and register one connection per topic."""
@@ -206,22 +251,79 @@ class BagRecorder:
             self._writer.add_connection(t.full_name(self._namespace), t.msgtype,
                                         typestore=self._store)
             for t in self._topics]
+        if self._bulk:
+            self._encoder = self._block_encoder()
         return self
 
+    def _block_encoder(self) -> BlockEncoder | None:
+        """Return the encoder of the topic table (None: some topic has no fixed layout)."""
+        learnt = [learn(self._store, t) for t in self._topics]
+        codecs = [c for c in learnt if c is not None]
+        if len(codecs) < len(learnt):
+            missing = [t.name for t, c in zip(self._topics, learnt) if c is None]
+            log.warning('no fixed CDR layout for %s: writing message by message',
+                        ', '.join(missing))
+            return None
+        if not self._mcap:
+            return BlockEncoder(self._topics, codecs)
+        prefixes = [message_prefix(c.id, len(codec.template))
+                    for c, codec in zip(self._connections, codecs)]
+        return BlockEncoder(self._topics, codecs, prefixes, TIME_OFFSETS)
+
     def write(self, frame: Frame) -> None:
-        """Write every topic's message for one frame, stamped with simulation time."""
-        stamp = frame.stamp_ns
-        serialize = self._store.serialize_cdr
-        for topic, conn in zip(self._topics, self._connections):
-            msg = topic.message(self._types, frame)
-            self._writer.write(conn, stamp, serialize(msg, topic.msgtype))
+        """Write (or keep for the next block) every topic's message of one frame."""
+        if self._encoder is None:
+            stamp = frame.stamp_ns
+            serialize = self._store.serialize_cdr
+            for topic, conn in zip(self._topics, self._connections):
+                msg = topic.message(self._types, frame)
+                self._writer.write(conn, stamp, serialize(msg, topic.msgtype))
+        else:
+            self._keep(frame)
         self.messages += len(self._topics)
 
+    def _keep(self, frame: Frame) -> None:
+        row = frame.row
+        if row.size != self._width:
+            self._set_width(row.size, frame.time)
+        self._rows.append(row)
+        self._stamps.append(frame.stamp_ns)
+        if len(self._rows) == self._capacity:
+            self.flush()
+
+    def _set_width(self, width: int, time: float) -> None:
+        """Take the number of values of the first frame (and size the blocks by it)."""
+        assert self._encoder is not None
+        if self._width >= 0:
+            raise ValueError(f'frame at t = {time:g} s has {width} values; the frames '
+                             f'before it had {self._width}')
+        needed = max((int(t.index.max(initial=0)) for t in self._topics), default=0) + 1
+        if width < needed:
+            raise ValueError(f'a frame has {width} values; the topic table reads {needed}')
+        self._width = width
+        self._capacity = max(1, min(MAX_BLOCK_FRAMES,
+                                    BLOCK_BYTES // max(self._encoder.width, 1)))
+
+    def flush(self) -> None:
+        """Write the frames kept for the block so far."""
+        rows, stamps, self._rows, self._stamps = self._rows, self._stamps, [], []
+        if not rows or self._encoder is None:
+            return
+        times = np.array(stamps, dtype=np.int64)
+        records = self._encoder.encode(times, np.stack(rows))
+        assert isinstance(self._writer, BlockWriter)
+        starts = self._encoder.starts if self._mcap else self._encoder.data_starts
+        self._writer.write_frames(self._connections, records, starts, self._encoder.ends,
+                                  times)
+
     def close(self) -> None:
-        """Close the bag (idempotent)."""
+        """Write the frames kept, then close the bag (idempotent)."""
         if self._open:
             self._open = False
-            self._writer.close()
+            try:
+                self.flush()
+            finally:
+                self._writer.close()
 
     def __exit__(self, exc_type: type[BaseException] | None, exc: BaseException | None,
                  tb: TracebackType | None) -> None:

@@ -20,14 +20,18 @@ typestore) and the live node (messages built from the rclpy classes): a
 conversion receives a ``types`` callable that maps a type name such as
 ``'geometry_msgs/msg/Vector3Stamped'`` to a message class, and builds the message
 with keyword arguments named exactly as the ROS fields. Every field is given, so
-the same call works for both back-ends.
+the same call works for both back-ends. A topic reads its numbers from the
+frame's flat row (:attr:`~ttb_sim.sim.Frame.row`) at its ``columns``, so that
+the values of many frames and topics are gathered with one index; the
+builders stay the one definition of each message, and the bags' bulk CDR
+layouts are learnt from them (:mod:`ttb_sim.io.codec`).
 """
 
 from __future__ import annotations
 
 import array
 from dataclasses import dataclass
-from functools import partial
+from functools import cached_property
 from typing import Any, Callable, Sequence
 
 import numpy as np
@@ -154,8 +158,9 @@ class Topic:
         Standard ROS 2 message type.
     fields : tuple of str
         Names of the numeric values that ``extract`` returns (for summaries).
-    extract : callable
-        Frame -> numeric values (SI).
+    columns : tuple of int
+        Where the topic's values are in a frame's flat row (:attr:`~ttb_sim.sim.Frame.row`,
+        mapped by :meth:`~ttb_sim.sim.Layout.columns`), in the order ``build`` takes them.
     build : callable
         (types, stamp_ns, values) -> message.
     qos : str
@@ -168,7 +173,7 @@ class Topic:
     name: str
     msgtype: str
     fields: tuple[str, ...]
-    extract: Callable[[Frame], np.ndarray]
+    columns: tuple[int, ...]
     build: Callable[[MessageTypes, int, np.ndarray], Any]
     qos: str = 'sensor'
     unit: str = ''
@@ -177,50 +182,23 @@ class Topic:
         """Return the absolute topic name under a node namespace."""
         return self.name if self.name.startswith('/') else f'{namespace}/{self.name}'
 
+    @cached_property
+    def index(self) -> np.ndarray:
+        """Return :attr:`columns` as an integer index array."""
+        return np.asarray(self.columns, dtype=np.intp)
+
+    def extract(self, frame: Frame) -> np.ndarray:
+        """Return the topic's numeric values (SI) of a frame."""
+        return frame.row[self.index]
+
     def message(self, types: MessageTypes, frame: Frame) -> Any:
         """Convert a frame to this topic's message."""
         return self.build(types, frame.stamp_ns, self.extract(frame))
 
 
-# Frame -> values of each topic family (the index arguments are bound per topic).
-def _no_values(frame: Frame) -> np.ndarray:
-    return np.zeros(0)
-
-
-def _odometry_values(frame: Frame) -> np.ndarray:
-    return np.array([frame.head_position, frame.speed])
-
-
-def _body_imu_values(body: int, frame: Frame) -> np.ndarray:
-    return np.concatenate([frame.body_acceleration[body], frame.body_angular_velocity[body]])
-
-
-def _wheel_rail_values(body: int, axle: int, side: int, frame: Frame) -> np.ndarray:
-    return np.concatenate([frame.wheel_rail[body, axle, side], np.zeros(3)])
-
-
-def _midspan_values(span: int, frame: Frame) -> np.ndarray:
-    return frame.midspan[span]
-
-
-def _bearing_values(support: int, side: int, frame: Frame) -> np.ndarray:
-    return np.concatenate([frame.bearings[support, side], np.zeros(3)])
-
-
-def _observer_values(observer: int, frame: Frame) -> np.ndarray:
-    return frame.observers[observer]
-
-
-def _pile_displacement_values(pile: int, frame: Frame) -> np.ndarray:
-    return frame.pile_displacement[pile]
-
-
-def _pile_imu_values(pile: int, frame: Frame) -> np.ndarray:
-    return np.concatenate([frame.pile_acceleration[pile], frame.pile_rotation_rate[pile]])
-
-
-def _soil_values(frame: Frame) -> np.ndarray:
-    return frame.soil_points.ravel()
+def _columns(*parts: np.ndarray) -> tuple[int, ...]:
+    """Return the row columns of some blocks of :meth:`~ttb_sim.sim.Layout.columns`, in order."""
+    return tuple(int(c) for part in parts for c in np.ravel(part))
 
 
 def topic_table(layout: Layout) -> list[Topic]:
@@ -237,71 +215,101 @@ def topic_table(layout: Layout) -> list[Topic]:
     list of Topic
 
     """
-    topics = [Topic('/clock', 'rosgraph_msgs/msg/Clock', (), _no_values, build_clock,
-                    qos='clock', unit='s')]
+    col = layout.columns()
+    pad3 = np.full(3, col['zero'])   # the torque of a force-only wrench
+    topics = [Topic('/clock', 'rosgraph_msgs/msg/Clock', (), (), build_clock, qos='clock',
+                    unit='s')]
     if layout.train:
         topics.append(Topic('train/odometry', 'nav_msgs/msg/Odometry',
                             ('pose.pose.position.x', 'twist.twist.linear.x'),
-                            _odometry_values, build_odometry, unit='m, m/s'))
+                            _columns(col['head_position'], col['speed']), build_odometry,
+                            unit='m, m/s'))
     for i in range(layout.n_bodies):
         topics.append(Topic(
             f'train/car{i + 1:02d}/body/imu', 'sensor_msgs/msg/Imu', IMU,
-            partial(_body_imu_values, i), build_imu, unit='m/s^2, rad/s'))
+            _columns(col['body_acceleration'][i], col['body_angular_velocity'][i]), build_imu,
+            unit='m/s^2, rad/s'))
         for k in range(layout.n_axles):
             for s, side in enumerate(('left', 'right')):
                 topics.append(Topic(
                     f'wheel_rail/car{i + 1:02d}/axle{k + 1}/{side}',
                     'geometry_msgs/msg/WrenchStamped', WRENCH,
-                    partial(_wheel_rail_values, i, k, s), build_wrench_stamped, unit='N'))
+                    _columns(col['wheel_rail'][i, k, s], pad3), build_wrench_stamped, unit='N'))
     for k in range(layout.n_spans):
         topics.append(Topic(f'bridge/span{k + 1:02d}/midspan',
                             'geometry_msgs/msg/Vector3Stamped', VECTOR3,
-                            partial(_midspan_values, k), build_vector3_stamped, unit='m'))
+                            _columns(col['midspan'][k]), build_vector3_stamped, unit='m'))
     for s in range(layout.n_supports):
         for side_index, side in enumerate(('left', 'right')):
             topics.append(Topic(
                 f'bearings/pier{s + 1:02d}/{side}', 'geometry_msgs/msg/WrenchStamped', WRENCH,
-                partial(_bearing_values, s, side_index), build_wrench_stamped, unit='N'))
+                _columns(col['bearings'][s, side_index], pad3), build_wrench_stamped,
+                unit='N'))
     index = 0
     for pier, n_piles in layout.piles:
         for m in range(n_piles):
             base = f'piles/pier{pier:02d}/pile{m + 1:02d}'
             topics.append(Topic(f'{base}/displacement', 'geometry_msgs/msg/Vector3Stamped',
-                                VECTOR3, partial(_pile_displacement_values, index),
+                                VECTOR3, _columns(col['pile_displacement'][index]),
                                 build_vector3_stamped, unit='m'))
             topics.append(Topic(f'{base}/imu', 'sensor_msgs/msg/Imu', IMU,
-                                partial(_pile_imu_values, index), build_imu,
+                                _columns(col['pile_acceleration'][index],
+                                         col['pile_rotation_rate'][index]), build_imu,
                                 unit='m/s^2, rad/s'))
             index += 1
     if layout.soil_points:
-        topics.append(Topic('soil/points', 'sensor_msgs/msg/PointCloud2', (), _soil_values,
-                            build_point_cloud, unit='m, m, m/s^2'))
+        topics.append(Topic('soil/points', 'sensor_msgs/msg/PointCloud2', (),
+                            _columns(col['soil_points']), build_point_cloud,
+                            unit='m, m, m/s^2'))
     for j, name in enumerate(layout.observers):
         topics.append(Topic(f'observers/{name}', 'geometry_msgs/msg/Vector3Stamped', VECTOR3,
-                            partial(_observer_values, j), build_vector3_stamped, unit='m'))
+                            _columns(col['observers'][j]), build_vector3_stamped, unit='m'))
     return topics
 
 
 class PeakTracker:
-    """Running minimum and maximum of every topic's numeric fields."""
+    """
+    Running minimum and maximum of every topic's numeric fields.
 
-    def __init__(self, topics: list[Topic], namespace: str = NAMESPACE) -> None:
+    The extremes are kept per column of the frames' flat rows
+    (:attr:`~ttb_sim.sim.Frame.row`): one ``minimum`` and one ``maximum`` per
+    frame (or per block of frames) over every value, read per topic at the end.
+    A value that is ever NaN stays NaN, and its topic is left out of the summary.
+    """
+
+    def __init__(self, topics: Sequence[Topic], namespace: str = NAMESPACE) -> None:
         self._topics = [t for t in topics if t.fields]
         self._names = [t.full_name(namespace) for t in self._topics]
-        self._lo = [np.full(len(t.fields), np.inf) for t in self._topics]
-        self._hi = [np.full(len(t.fields), -np.inf) for t in self._topics]
+        self._lo: np.ndarray | None = None
+        self._hi: np.ndarray | None = None
 
     def update(self, frame: Frame) -> None:
         """Fold one frame into the running extremes."""
-        for i, topic in enumerate(self._topics):
-            values = topic.extract(frame)
-            np.minimum(self._lo[i], values, out=self._lo[i])
-            np.maximum(self._hi[i], values, out=self._hi[i])
+        row = frame.row
+        if self._lo is None or self._hi is None:
+            self._lo, self._hi = row.copy(), row.copy()
+            return
+        np.minimum(self._lo, row, out=self._lo)
+        np.maximum(self._hi, row, out=self._hi)
+
+    def update_rows(self, rows: np.ndarray) -> None:
+        """Fold the flat rows ``(frames, width)`` of some frames into the running extremes."""
+        if not len(rows):
+            return
+        lo, hi = np.min(rows, axis=0), np.max(rows, axis=0)
+        if self._lo is None or self._hi is None:
+            self._lo, self._hi = lo, hi
+            return
+        np.minimum(self._lo, lo, out=self._lo)
+        np.maximum(self._hi, hi, out=self._hi)
 
     def summary(self) -> dict[str, dict[str, dict[str, float]]]:
         """Return {topic: {field: {min, max, abs_max}}} (fields never seen are omitted)."""
         out: dict[str, dict[str, dict[str, float]]] = {}
-        for name, topic, lo, hi in zip(self._names, self._topics, self._lo, self._hi):
+        if self._lo is None or self._hi is None:
+            return out
+        for name, topic in zip(self._names, self._topics):
+            lo, hi = self._lo[topic.index], self._hi[topic.index]
             if not np.all(np.isfinite(lo)):
                 continue
             out[name] = {f: {'min': float(a), 'max': float(b),

@@ -20,8 +20,10 @@ a header, a time, vectors, covariance arrays per message) was most of the
 node's publishing cost. :class:`MessageCache` builds each topic's message once
 from the first frame and afterwards writes only what changes: the stamp, once
 per frame in one :class:`std_msgs/msg/Header` that all stamped messages share,
-and the numbers of each topic. A publisher serialises the message when it is
-published, so handing the same object out again for the next frame is safe.
+and the numbers of each topic, all gathered from the frame's flat row
+(:attr:`~ttb_sim.sim.Frame.row`) with one index. A publisher serialises the
+message when it is published, so handing the same object out again for the
+next frame is safe.
 
 It works with any message classes of the standard field names (rclpy's or
 rosbags'), so it is tested without ROS: every message it hands out serialises
@@ -33,6 +35,8 @@ built from scratch every frame.
 from __future__ import annotations
 
 from typing import Any, Callable, Sequence
+
+import numpy as np
 
 from ttb_sim.io.topics import MessageTypes, Topic
 from ttb_sim.sim import Frame
@@ -92,6 +96,9 @@ class MessageCache:
         self._types = types
         self._header: Any = None
         self._entries: list[tuple[Topic, Any, Updater | None]] = []
+        self._index = np.concatenate([t.index for t in self.topics] or [np.zeros(0, np.intp)])
+        ends = np.cumsum([len(t.columns) for t in self.topics], dtype=int).tolist()
+        self._spans = list(zip([0, *ends[:-1]], ends))
 
     def _build(self, frame: Frame) -> None:
         self._header = self._types('std_msgs/msg/Header')(
@@ -117,11 +124,12 @@ class MessageCache:
         sec, nanosec = divmod(int(frame.stamp_ns), 1_000_000_000)
         stamp = self._header.stamp
         stamp.sec, stamp.nanosec = sec, nanosec
+        values = frame.row[self._index].tolist()   # every topic's values, as Python floats
         out = []
-        for topic, msg, update in self._entries:
+        for (topic, msg, update), (start, end) in zip(self._entries, self._spans):
             if update is None:
                 msg = topic.message(self._types, frame)
             else:
-                update(topic.extract(frame).tolist())
+                update(values[start:end])
             out.append(msg)
         return out

@@ -12,13 +12,29 @@
 # See the License for the specific language governing permissions and
 # limitations under the License.
 
-"""Frames: what the stepping core emits at each output tick (SI units, track axes)."""
+"""
+Frames: what the stepping core emits at each output tick (SI units, track axes).
+
+Every frame of a run also reads as one flat float64 row (:attr:`Frame.row`): a
+zero, then every field of the frame in :data:`ROW_FIELDS` order, each raveled
+in C order. :meth:`Layout.columns` says where each value lands in that row, so
+the writers gather any topic's values of many frames with one index, and fold
+extremes over all values at once.
+"""
 
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from functools import cached_property
 
 import numpy as np
+
+ROW_FIELDS = ('head_position', 'speed', 'midspan', 'bearings', 'body_acceleration',
+              'body_angular_velocity', 'wheel_rail', 'observers', 'pile_displacement',
+              'pile_acceleration', 'pile_rotation_rate', 'soil_points')
+"""The fields of a :class:`Frame` in the order of :attr:`Frame.row` (after its leading zero)."""
+ZERO_COLUMN = 0
+"""The column of :attr:`Frame.row` that always holds 0.0 (for values a topic pads with)."""
 
 
 @dataclass(frozen=True)
@@ -44,6 +60,57 @@ class Layout:
     def n_piles(self) -> int:
         """Total number of piles over all piled piers."""
         return sum(n for _, n in self.piles)
+
+    def shapes(self) -> dict[str, tuple[int, ...]]:
+        """Return the shape of every field of a frame of this layout, by :data:`ROW_FIELDS`."""
+        bodies, piles = (self.n_bodies, 3), (self.n_piles, 3)
+        return {'head_position': (), 'speed': (), 'midspan': (self.n_spans, 3),
+                'bearings': (self.n_supports, 2, 3), 'body_acceleration': bodies,
+                'body_angular_velocity': bodies,
+                'wheel_rail': (self.n_bodies, self.n_axles, 2, 3),
+                'observers': (len(self.observers), 3), 'pile_displacement': piles,
+                'pile_acceleration': piles, 'pile_rotation_rate': piles,
+                'soil_points': (self.soil_points, 9)}
+
+    @property
+    def row_width(self) -> int:
+        """Return the number of values in :attr:`Frame.row` of a frame of this layout."""
+        return 1 + sum(int(np.prod(s, dtype=np.int64)) for s in self.shapes().values())
+
+    def columns(self) -> dict[str, np.ndarray]:
+        """
+        Return the column of :attr:`Frame.row` of every value of every field.
+
+        Returns
+        -------
+        dict of str to numpy.ndarray
+            Per field of :data:`ROW_FIELDS`, integer columns shaped like the field
+            (``columns(...)['wheel_rail'][body, axle, side]`` are the 3 columns of
+            that wheel's force); and ``'zero'``: the column that always holds 0.0.
+
+        """
+        out: dict[str, np.ndarray] = {'zero': np.array(ZERO_COLUMN)}
+        start = ZERO_COLUMN + 1
+        for name, shape in self.shapes().items():
+            size = int(np.prod(shape, dtype=np.int64))
+            out[name] = np.arange(start, start + size).reshape(shape)
+            start += size
+        return out
+
+    def check(self, frame: Frame) -> None:
+        """
+        Raise ValueError unless every field of ``frame`` has this layout's shape.
+
+        Raises
+        ------
+        ValueError
+            Naming the first field whose shape differs.
+
+        """
+        for name, shape in self.shapes().items():
+            got = np.shape(getattr(frame, name))
+            if got != shape:
+                raise ValueError(f'frame field {name} has shape {got}; the layout says {shape}')
 
 
 @dataclass(frozen=True)
@@ -86,6 +153,20 @@ class Frame:
     pile_acceleration: np.ndarray = field(default_factory=lambda: np.zeros((0, 3)))
     pile_rotation_rate: np.ndarray = field(default_factory=lambda: np.zeros((0, 3)))
     soil_points: np.ndarray = field(default_factory=lambda: np.zeros((0, 9)))
+
+    @cached_property
+    def row(self) -> np.ndarray:
+        """
+        Return every value of the frame in one flat float64 array, computed once.
+
+        ``row[0]`` is 0.0 (:data:`ZERO_COLUMN`); then the fields of :data:`ROW_FIELDS`,
+        each raveled in C order; :meth:`Layout.columns` maps them.
+        """
+        return np.concatenate(   # in ROW_FIELDS order; axis None ravels each
+            ((0.0, self.head_position, self.speed), self.midspan, self.bearings,
+             self.body_acceleration, self.body_angular_velocity, self.wheel_rail,
+             self.observers, self.pile_displacement, self.pile_acceleration,
+             self.pile_rotation_rate, self.soil_points), axis=None, dtype=np.float64)
 
     @property
     def stamp_ns(self) -> int:
