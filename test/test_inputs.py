@@ -109,6 +109,33 @@ def test_yaml_errors_name_the_file(tmp_path, capsys):
     assert f'(in "{path}", line 2, column 1)' in err
 
 
+def test_a_key_given_twice_is_refused_naming_it_and_both_lines(tmp_path, capsys):
+    path = tmp_path / 'twice.yaml'
+    path.write_text('bridge:\n  span_length: 30\n  n_spans: 3\n  span_length: 25\n'
+                    'train:\n  speed_kmh: 250\n')
+    err = _cli(tmp_path, capsys, str(path))
+    assert err == (f'ttb-sim: error: scenario file {str(path)!r} is not valid YAML: key '
+                   "'bridge.span_length' is given twice, on lines 2 and 4; give it once\n")
+
+
+@pytest.mark.parametrize('text, words', [
+    ('name: a\nname: b\n', "key 'name' is given twice, on lines 1 and 2"),
+    ('train: {speed_kmh: 1, speed_kmh: 2}\n', "key 'train.speed_kmh' is given twice, on line 1, "
+     'columns 9 and 23'),
+    ('output:\n  observers: [{a: 1, a: 2}]\n', r"key 'output.observers\[0\].a' is given twice"),
+])
+def test_duplicate_keys_are_refused_at_any_depth(tmp_path, text, words):
+    path = tmp_path / 's.yaml'
+    path.write_text(text)
+    with pytest.raises(ScenarioError, match=words):
+        load_scenario(path)
+
+
+def test_a_duplicate_key_in_a_set_value_is_refused():
+    with pytest.raises(ScenarioError, match="value is not valid YAML .key 'a' is given twice"):
+        load_scenario('moving_force_beam', ['description={a: 1, a: 2}'])
+
+
 @pytest.mark.parametrize('text, words', [
     ('a: ' + '1' * 5000, 'a value cannot be read'),
     ('a: 2001-13-45', 'a value cannot be read'),
