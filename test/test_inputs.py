@@ -136,6 +136,16 @@ def test_a_duplicate_key_in_a_set_value_is_refused():
         load_scenario('moving_force_beam', ['description={a: 1, a: 2}'])
 
 
+@pytest.mark.parametrize('text', ['', '\n\n', '# only a comment\n', '  # indented\n\n# two\n',
+                                  '---\n'])
+def test_an_empty_scenario_file_is_refused(tmp_path, capsys, text):
+    path = tmp_path / 'empty.yaml'
+    path.write_text(text)
+    err = _cli(tmp_path, capsys, str(path))
+    assert err.startswith(f'ttb-sim: error: scenario file {str(path)!r} is empty (no keys, '
+                          'only blank lines or comments); give the keys to set')
+
+
 @pytest.mark.parametrize('text, words', [
     ('a: ' + '1' * 5000, 'a value cannot be read'),
     ('a: 2001-13-45', 'a value cannot be read'),

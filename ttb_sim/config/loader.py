@@ -332,8 +332,8 @@ def load_scenario(source: str | Path, overrides: Sequence[str] = (),
     Raises
     ------
     ScenarioError
-        If the file cannot be read or parsed, gives a key twice, or any key is
-        invalid.
+        If the file cannot be read or parsed, is empty (only blank lines or
+        comments), gives a key twice, or any key is invalid.
 
     """
     path = resolve(source)
@@ -345,7 +345,10 @@ def load_scenario(source: str | Path, overrides: Sequence[str] = (),
         raise ScenarioError(f'scenario file {name} is not valid YAML: '
                             f'{yaml_problem(exc)}') from None
     if data is None:
-        data = {}
+        message = (f'scenario file {name} is empty (no keys, only blank lines or comments); '
+                   'give the keys to set, e.g. "train: {speed_kmh: 250}", or run a built-in '
+                   'scenario (ttb-sim scenarios)')
+        raise ScenarioError(message)
     if not isinstance(data, dict):
         raise ScenarioError(f'scenario file {name} must hold a mapping of keys, got '
                             f'{shown(data)}')
