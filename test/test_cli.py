@@ -40,6 +40,16 @@ def test_bad_input_exit_2_nothing_written(tmp_path: Path, capsys, args, match):
     assert not out.exists()
 
 
+def test_a_section_given_to_set_is_named_as_a_section(tmp_path: Path, capsys):
+    out = tmp_path / 'out'
+    assert main(['run', 'moving_force_beam', '--out', str(out), '--set', 'train=5']) == 2
+    assert capsys.readouterr().err == (
+        'ttb-sim: error: train = 5: train is a section, not a value; set one of its keys, e.g. '
+        'train.speed_kmh (its 11 keys: train.vehicle, train.speed_kmh, train.start_position, '
+        'train.axle_offsets, ...; see `ttb-sim scenarios --keys`)\n')
+    assert not out.exists()
+
+
 def test_unreadable_scenario_exit_2(tmp_path: Path, capsys):
     assert main(['run', str(tmp_path / 'missing.yaml'), '--out', str(tmp_path / 'o')]) == 2
     assert 'does not exist' in capsys.readouterr().err

@@ -23,7 +23,7 @@ import sysconfig
 from typing import Any, Sequence
 
 from ttb_sim.config.records import Scenario
-from ttb_sim.config.schema import canonical_key, from_mapping, key_spec
+from ttb_sim.config.schema import canonical_key, from_mapping, key_spec, section_problem
 from ttb_sim.errors import ScenarioError
 from ttb_sim.inputs import MAX_SHOWN, read_user_file, shown
 import yaml
@@ -293,10 +293,15 @@ def apply_overrides(data: dict[str, Any], overrides: Sequence[tuple[str, Any]]) 
     Raises
     ------
     ScenarioError
-        If a key does not exist in the schema.
+        If a key does not exist in the schema, or names a section (a group of
+        keys such as ``train``) instead of a key.
 
     """
     for key, value in overrides:
+        problem = section_problem(canonical_key(key))
+        if problem is not None:
+            message = f'{key} = {shown(value)}: {problem}'
+            raise ScenarioError(message)
         key_spec(key)  # raises on unknown keys
         key = canonical_key(key)
         node = data
