@@ -22,6 +22,7 @@ of issue 13 (nine levels of ten aliases: 10^9 items if expanded).
 
 import os
 from pathlib import Path
+import re
 import time
 
 import pytest
@@ -252,6 +253,38 @@ def test_a_huge_csv_cell_gives_a_short_message(tmp_path):
     with pytest.raises(ScenarioError, match=r'\(10000 characters\)') as info:
         load_csv(path)
     assert len(str(info.value)) < 500
+
+
+@pytest.mark.parametrize('text, message', [
+    ('x,z_left,z_right,y_left,y_right\n0,0,0,0,0\n0.25,abc,0,0,0\n',
+     "row 3: non-numeric value 'abc' in column z_left"),
+    ('0,0,0,0,0\nq,0,0,0,0\n', "row 2: non-numeric value 'q' in column x"),
+    ('y_right,x,z_left,z_right,y_left\n0,0,0,0,0\n1,0.25,0,0,\n',
+     "row 3: non-numeric value '' in column y_left"),
+    ('x,z_left,z_right,y_left,y_right\n0,0,0,0,0\n0.25,0,0,inf,0\n',
+     "row 3: value 'inf' in column y_left is not a finite number"),
+    ('x,z_left,z_right,y_left,y_right\n0,0,0,0\n', 'row 2: expected 5 fields as in the header'),
+])
+def test_a_short_csv_with_a_bad_cell_names_the_cell(tmp_path, capsys, text, message):
+    path = tmp_path / 'short.csv'
+    path.write_text(text)
+    err = _cli(tmp_path, capsys, 'sprung_mass_beam', '--duration', '0.01', '--set',
+               f'irregularity.file={path}')
+    assert message in err and 'too few rows' not in err
+    with pytest.raises(ScenarioError, match=f'^{re.escape(str(path))}: {re.escape(message)}'):
+        load_csv(path)
+
+
+def test_a_short_csv_of_good_cells_is_refused_for_its_rows(tmp_path):
+    path = tmp_path / 'short.csv'
+    path.write_text('x,z_left,z_right,y_left,y_right\n0,0,0,0,0\n0.25,0,0,0,0\n')
+    with pytest.raises(ScenarioError, match=r'row 3: too few rows: 2 data row\(s\) \(last data '
+                       r'row 3\), need at least 4'):
+        load_csv(path)
+    path.write_text('x,z_left,z_right,y_left,y_right\n# no data\n')
+    with pytest.raises(ScenarioError, match=r'row 1: too few rows: 0 data row\(s\) \(no data '
+                       r'rows\)'):
+        load_csv(path)
 
 
 def test_read_user_file_reads_a_small_regular_file(tmp_path):
