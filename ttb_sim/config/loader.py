@@ -188,7 +188,8 @@ def yaml_problem(exc: yaml.YAMLError) -> str:
 
 
 def _one_line(text: str) -> str:
-    """Return a message on one line (control characters escaped), cut to a few hundred characters.
+    """
+    Return a message on one line (control characters escaped), cut to a few hundred characters.
 
     PyYAML's messages may quote a long piece of the input; ours quote values through
     :func:`shown` already, so the bound is a few times ``MAX_SHOWN``.
