@@ -28,6 +28,7 @@ import argparse
 import logging
 import os
 from pathlib import Path
+import re
 import sys
 import threading
 from typing import Any, Sequence
@@ -174,6 +175,11 @@ def entry() -> None:
     os._exit(code)
 
 
+def one_line(exc: BaseException) -> str:
+    """Return an error's message on one line (a library's text may span several)."""
+    return re.sub(r'\s*\n\s*', ' ', str(exc).strip())
+
+
 def _main(argv: Sequence[str] | None) -> int:
     parser = _parser()
     args = parser.parse_args(argv)
@@ -213,10 +219,10 @@ def _main(argv: Sequence[str] | None) -> int:
         from ttb_sim.commands.scenarios import scenarios
         return scenarios(keys=args.keys)
     except (ScenarioError, ModelError) as exc:
-        print(f'ttb-sim: error: {exc}', file=sys.stderr)
+        print(f'ttb-sim: error: {one_line(exc)}', file=sys.stderr)
         return EXIT_USAGE
     except TtbSimError as exc:
-        print(f'ttb-sim: failed: {exc}', file=sys.stderr)
+        print(f'ttb-sim: failed: {one_line(exc)}', file=sys.stderr)
         return EXIT_FAILURE
     except BrokenPipeError:  # stdout closed early (`ttb-sim scenarios | head`): not an error
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())

@@ -27,6 +27,7 @@ from __future__ import annotations
 import csv
 import json
 import math
+import re
 import subprocess
 import sys
 
@@ -197,6 +198,40 @@ def test_bad_input_exit_2_without_traceback(bag, tmp_path, capsys):
     assert [p.name for p in busy.iterdir()] == ['thesis.tex']
     for folder in (not_bag, truncated, killed, empty):
         assert not (folder / 'analysis').exists()
+
+
+def test_a_broken_metadata_file_is_one_line_exit_2(bag, tmp_path, capsys):
+    """Issue #28 5.5: what is wrong with which file, in one line; no advice to recover."""
+    broken = tmp_path / 'broken'
+    broken.mkdir()
+    (broken / 'metadata.yaml').write_text('rosbag2_bagfile_information: [\n')
+    for data in bag.glob('*.mcap'):
+        (broken / data.name).write_bytes(data.read_bytes())
+    assert main(['analyze', str(broken)]) == 2
+    err = capsys.readouterr().err
+    # libyaml words the problem 'did not find expected node content', PyYAML's Python parser
+    # 'expected the node content, but found ...'
+    assert re.fullmatch(f"ttb-sim: error: bag metadata '{re.escape(str(broken))}/metadata.yaml' "
+                        r'is not valid YAML: while parsing a flow node; [^\n]*node content[^\n]* '
+                        r'\(line 2, column 1\)\n', err), err
+    assert not (broken / 'analysis').exists()
+    result = run_cli('analyze', str(broken))
+    assert (result.returncode, result.stderr) == (2, err)
+
+
+def test_a_cut_mcap_points_to_recovery_in_one_line(bag, tmp_path, capsys):
+    cut = tmp_path / 'cut'
+    cut.mkdir()
+    (cut / 'metadata.yaml').write_bytes((bag / 'metadata.yaml').read_bytes())
+    data = next(bag.glob('*.mcap'))
+    (cut / data.name).write_bytes(data.read_bytes()[:len(data.read_bytes()) // 3])
+    assert main(['analyze', str(cut)]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith(f"ttb-sim: error: bag '{cut}' is truncated or corrupt "
+                          f"('{cut / data.name}': ")
+    assert err.endswith('; a recording that was killed leaves such a file: `mcap recover` may '
+                        'rescue it\n')
+    assert err.count('\n') == 1
 
 
 def test_compare_overlays_and_differences(bag, tmp_path):

@@ -17,9 +17,10 @@ Input and output: the topic table, the rosbag2 recorder, the bag reader and the 
 
 ``topics`` maps frames to standard ROS 2 messages (one table for the node and the
 bags), ``bag`` records frames to rosbag2 (MCAP or SQLite 3), ``reader`` reads any
-bag of ours back into numpy arrays per topic, ``streams`` sorts those arrays into
-named, evenly sampled streams (car bodies, wheel-rail forces, girders, piles, soil)
-for the reports.
+bag of ours back into numpy arrays per topic (``bag_checks`` says in one line what
+is wrong with a bag it cannot read), ``streams`` sorts those arrays into named,
+evenly sampled streams (car bodies, wheel-rail forces, girders, piles, soil) for
+the reports.
 """
 
 from ttb_sim.io.bag import BagRecorder, default_bag_path, STORAGES

@@ -68,8 +68,10 @@ from pathlib import Path
 from typing import Any, Iterable, Iterator, Mapping, Sequence
 
 import numpy as np
-from rosbags.rosbag2 import Reader, ReaderError
+from rosbags.rosbag2 import Reader
+from rosbags.serde import SerdeError
 from ttb_sim.errors import BagError
+from ttb_sim.io.bag_checks import check_metadata, CORRUPT, one_line, unreadable
 from ttb_sim.io.cdr import Group, groups, typestore
 
 log = logging.getLogger(__name__)
@@ -238,13 +240,18 @@ def read_bag(path: str | Path, topics: Iterable[str] | None = None) -> dict[str,
                                           if connections else ()):
                 raw[conn.topic].append(data)
                 received[conn.topic].append(timestamp)
-        except ReaderError as exc:
-            raise BagError(_unreadable(path, exc)) from None
+        except CORRUPT as exc:   # a record cut short, or a length field gone wrong
+            raise BagError(unreadable(path, exc)) from None
     store = typestore()
     out: dict[str, TopicArrays] = {}
     for topic in wanted:
         msgtype = available[topic]
-        stamp_ns, fields, components = _decode(store, msgtype, raw[topic])
+        try:
+            stamp_ns, fields, components = _decode(store, msgtype, raw[topic])
+        except (SerdeError, *CORRUPT, ValueError) as exc:
+            msg = f'bag {str(path)!r} is corrupt: the messages of {topic} ({msgtype}) cannot ' \
+                  f'be decoded ({type(exc).__name__}: {one_line(str(exc))})'
+            raise BagError(msg) from None
         out[topic] = TopicArrays(topic, msgtype, stamp_ns,
                                  np.asarray(received[topic], dtype=np.int64), fields,
                                  components)
@@ -256,7 +263,7 @@ def read_bag(path: str | Path, topics: Iterable[str] | None = None) -> dict[str,
 
 @contextmanager
 def _open(path: Path) -> Iterator[Reader]:
-    """Open a bag with rosbags, translating its errors to :class:`BagError`."""
+    """Open a bag with rosbags, translating its errors to one-line :class:`BagError`."""
     if not path.exists():
         raise BagError(f'bag {str(path)!r} does not exist')
     if path.is_file() and path.suffix not in ('.mcap', '.db3'):
@@ -271,22 +278,20 @@ def _open(path: Path) -> Iterator[Reader]:
         else:
             msg = f'{str(path)!r} is not a rosbag2 directory (no metadata.yaml)'
         raise BagError(msg)
+    if path.is_dir():
+        check_metadata(path / 'metadata.yaml')
     try:
         reader = Reader(path)
         reader.open()
-    except ReaderError as exc:
-        raise BagError(_unreadable(path, exc)) from None
+    except CORRUPT as exc:
+        raise BagError(unreadable(path, exc)) from None
     except (OSError, ValueError, KeyError) as exc:
-        raise BagError(f'bag {str(path)!r} cannot be read: {exc}') from None
+        msg = f'bag {str(path)!r} cannot be read: {one_line(str(exc))}'
+        raise BagError(msg) from None
     try:
         yield reader
     finally:
         reader.close()
-
-
-def _unreadable(path: Path, exc: Exception) -> str:
-    return f'bag {str(path)!r} is truncated or corrupt ({exc}); a recording that was ' \
-           'killed leaves such a file: `mcap recover` (MCAP) may rescue it'
 
 
 def _select(path: Path, available: Mapping[str, str],
