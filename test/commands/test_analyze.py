@@ -234,6 +234,35 @@ def test_a_cut_mcap_points_to_recovery_in_one_line(bag, tmp_path, capsys):
     assert err.count('\n') == 1
 
 
+HEAVY = ('matplotlib', 'scipy', 'ttb_sim.analysis', 'ttb_sim.sim')
+"""What analyze and compare import only for a bag they can read (seconds at load)."""
+
+
+def test_refusals_come_before_the_heavy_imports(bag, tmp_path):
+    """Issue #28 5.6: a wrong path is refused before scipy, matplotlib or the model load."""
+    broken = tmp_path / 'broken'
+    broken.mkdir()
+    (broken / 'metadata.yaml').write_text('rosbag2_bagfile_information: {relative_file_paths: '
+                                          '[gone.mcap]}\n')
+    cut = tmp_path / 'cut'
+    cut.mkdir()
+    (cut / 'metadata.yaml').write_bytes((bag / 'metadata.yaml').read_bytes())
+    data = next(bag.glob('*.mcap'))
+    (cut / data.name).write_bytes(data.read_bytes()[:1000])
+    (tmp_path / 'file').write_text('x')
+    cases = [['analyze', str(tmp_path / 'missing')], ['analyze', str(broken)],
+             ['analyze', str(cut)], ['analyze', str(bag), '--out', str(tmp_path / 'file')],
+             ['compare', str(bag), str(tmp_path / 'missing')], ['compare', str(bag), str(cut)]]
+    script = ('import json, sys\nfrom ttb_sim.cli import main\n'
+              'code = main(json.loads(sys.argv[1]))\n'
+              f'print(code, [m for m in {HEAVY!r} if m in sys.modules])')
+    for args in cases:
+        result = subprocess.run([sys.executable, '-c', script, json.dumps(args)],
+                                capture_output=True, text=True, timeout=300)
+        assert result.stdout == '2 []\n', (args, result.stdout, result.stderr)
+        assert result.stderr.startswith('ttb-sim: error: ') and result.stderr.count('\n') == 1
+
+
 def test_compare_overlays_and_differences(bag, tmp_path):
     other = sb.write_bag(tmp_path / 'louder', scale=1.5)
     out = tmp_path / 'cmp'

@@ -253,7 +253,7 @@ def test_recovery_is_pointed_to_only_for_a_cut_mcap(written, tmp_path: Path, sto
     ('- 1\n', r'is not rosbag2 metadata: .* found a list$'),
     ('rosbag2_bagfile_information: {}\n', r"is invalid: the key 'version' is missing$"),
     ('rosbag2_bagfile_information: {version: 9, relative_file_paths: [gone.mcap]}\n',
-     r'is invalid: Some database files are missing: .*gone.mcap'),
+     r"lists storage files that are not in '.*meta': gone.mcap$"),
 ])
 def test_a_broken_metadata_file_is_named_in_one_line(written, tmp_path: Path, text, message):
     paths, _ = written

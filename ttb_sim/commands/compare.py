@@ -32,10 +32,7 @@ import time
 from typing import Sequence
 
 from ttb_sim.errors import ScenarioError
-from ttb_sim.io.bag import default_bag_path
-from ttb_sim.io.streams import load_streams
-from ttb_sim.report.figures import write_figures
-from ttb_sim.report.metrics import bag_metrics, differences
+from ttb_sim.io.bag_checks import check_bag_path
 from ttb_sim.report.output import check_output, staged_output, write_index, write_json
 
 log = logging.getLogger(__name__)
@@ -63,10 +60,19 @@ def compare(bags: Sequence[str | Path], *, labels: str | Sequence[str] | None = 
     paths = [Path(b) for b in bags]
     if len(paths) < 2:
         raise ScenarioError(f'compare needs at least two bags, got {len(paths)}')
+    for p in paths:
+        check_bag_path(p)
     names = _labels(paths, labels)
+    if out is not None:
+        check_output(Path(out))
+    from ttb_sim.io.streams import load_streams   # the bag reader, after the checks
+    streams = [load_streams(p, label) for p, label in zip(paths, names)]
+    if out is None:   # (io.bag imports the stepping core: not for a refusal)
+        from ttb_sim.io.bag import default_bag_path
     target = Path(out) if out is not None else default_bag_path('compare')
     check_output(target)
-    streams = [load_streams(p, label) for p, label in zip(paths, names)]
+    from ttb_sim.report.figures import write_figures   # scipy and matplotlib: readable bags
+    from ttb_sim.report.metrics import bag_metrics, differences
     metrics = [bag_metrics(s) for s in streams]
     rows = differences(names, metrics)
     head = ['metric', *names]

@@ -18,31 +18,27 @@ Bag files that cannot be read, said in one line: what is wrong with which file.
 :func:`check_metadata` refuses a ``metadata.yaml`` that is not YAML or not
 rosbag2 metadata before rosbags reads it (its own messages quote the YAML
 parser over several lines); :func:`unreadable` words what rosbags or a damaged
-storage file raised (:data:`CORRUPT`), pointing to ``mcap recover`` only for an
-MCAP file cut short; :func:`one_line` bounds a library's message.
+storage file raised, pointing to ``mcap recover`` only for an MCAP file cut
+short; :func:`one_line` bounds a library's message. :func:`check_bag_path` makes
+every check that needs no bag library, so that a verb can refuse a wrong path
+before it imports one.
 """
 
 from __future__ import annotations
 
 from pathlib import Path
 import re
-import struct
 
-from rosbags.rosbag2 import ReaderError
 from ttb_sim.errors import BagError
 import yaml
 
-__all__ = ['check_metadata', 'CORRUPT', 'MAX_METADATA_BYTES', 'one_line', 'unreadable']
+__all__ = ['check_bag_path', 'check_metadata', 'MAX_METADATA_BYTES', 'one_line', 'unreadable']
 
 MAX_METADATA_BYTES = 64 << 20
 """Largest ``metadata.yaml`` read (bytes); ours are about 100 bytes per topic."""
 
 MAX_DETAIL = 300
 """Most characters of a reader's own message quoted in a BagError."""
-
-CORRUPT = (ReaderError, OverflowError, EOFError, IndexError, struct.error, MemoryError,
-           UnicodeDecodeError)
-"""What reading a damaged storage file raises (rosbags checks most, not every length field)."""
 
 METADATA_PROBLEMS = ('Could not read metadata', 'Could not load YAML',
                      'A metadata key is missing', 'Invalid bag metadata', 'Rosbag2 version',
@@ -63,6 +59,42 @@ def one_line(text: str) -> str:
     return text
 
 
+def check_bag_path(path: Path) -> None:
+    """
+    Refuse a path that is not a bag, without reading its storage files.
+
+    Raises
+    ------
+    BagError
+        If ``path`` does not exist, is a file other than ``.mcap`` / ``.db3``,
+        neither a file nor a directory, a directory without ``metadata.yaml``
+        (a killed recording, when it holds storage files) or with a
+        ``metadata.yaml`` that :func:`check_metadata` refuses.
+
+    """
+    if not path.exists():
+        raise BagError(f'bag {str(path)!r} does not exist')
+    if path.is_file():
+        if path.suffix not in ('.mcap', '.db3'):
+            msg = f'{str(path)!r} is not a bag: give its directory (with metadata.yaml) or ' \
+                  'its .mcap / .db3 file'
+            raise BagError(msg)
+        return
+    if not path.is_dir():
+        raise BagError(f'{str(path)!r} is not a bag: neither a file nor a directory')
+    if not (path / 'metadata.yaml').is_file():
+        storage = sorted(p.name for p in path.iterdir() if p.suffix in ('.mcap', '.db3'))
+        if storage:
+            tools = '`ros2 bag reindex` or `mcap recover`' if any(
+                name.endswith('.mcap') for name in storage) else '`ros2 bag reindex`'
+            msg = f'{str(path)!r} has {", ".join(storage)} but no metadata.yaml: the ' \
+                  f'recording did not finish (a killed run?); {tools} may rescue it'
+        else:
+            msg = f'{str(path)!r} is not a rosbag2 directory (no metadata.yaml)'
+        raise BagError(msg)
+    check_metadata(path / 'metadata.yaml')
+
+
 def check_metadata(path: Path) -> None:
     """
     Refuse a ``metadata.yaml`` that is not YAML or not rosbag2 metadata, naming the file.
@@ -74,7 +106,8 @@ def check_metadata(path: Path) -> None:
     ------
     BagError
         If the file cannot be read, is larger than :data:`MAX_METADATA_BYTES`,
-        is not valid YAML, or lacks the ``rosbag2_bagfile_information`` mapping.
+        is not valid YAML, lacks the ``rosbag2_bagfile_information`` mapping,
+        or lists storage files that are not beside it.
 
     """
     name = f'bag metadata {str(path)!r}'
@@ -103,6 +136,13 @@ def check_metadata(path: Path) -> None:
         msg = f'{name} is not rosbag2 metadata: it needs a mapping ' \
               f"'rosbag2_bagfile_information' at the top, found {found}"
         raise BagError(msg)
+    files = info.get('relative_file_paths')
+    if isinstance(files, list):
+        missing = [str(f) for f in files if not (path.parent / Path(str(f)).name).is_file()]
+        if missing:
+            msg = f'{name} lists storage files that are not in {str(path.parent)!r}: ' \
+                  f'{one_line(", ".join(missing))}'
+            raise BagError(msg)
 
 
 def _yaml_problem(exc: yaml.YAMLError) -> str:

@@ -65,13 +65,14 @@ from contextlib import contextmanager
 from dataclasses import dataclass
 import logging
 from pathlib import Path
+import struct
 from typing import Any, Iterable, Iterator, Mapping, Sequence
 
 import numpy as np
-from rosbags.rosbag2 import Reader
+from rosbags.rosbag2 import Reader, ReaderError
 from rosbags.serde import SerdeError
 from ttb_sim.errors import BagError
-from ttb_sim.io.bag_checks import check_metadata, CORRUPT, one_line, unreadable
+from ttb_sim.io.bag_checks import check_bag_path, one_line, unreadable
 from ttb_sim.io.cdr import Group, groups, typestore
 
 log = logging.getLogger(__name__)
@@ -259,27 +260,17 @@ def read_bag(path: str | Path, topics: Iterable[str] | None = None) -> dict[str,
     return out
 
 
+CORRUPT = (ReaderError, OverflowError, EOFError, IndexError, struct.error, MemoryError,
+           UnicodeDecodeError)
+"""What reading a damaged storage file raises (rosbags checks most, not every length field)."""
+
+
 # -- opening and selecting --------------------------------------------------------------
 
 @contextmanager
 def _open(path: Path) -> Iterator[Reader]:
     """Open a bag with rosbags, translating its errors to one-line :class:`BagError`."""
-    if not path.exists():
-        raise BagError(f'bag {str(path)!r} does not exist')
-    if path.is_file() and path.suffix not in ('.mcap', '.db3'):
-        raise BagError(f'{str(path)!r} is not a bag: give its directory (with metadata.yaml) '
-                       'or its .mcap / .db3 file')
-    if path.is_dir() and not (path / 'metadata.yaml').is_file():
-        storage = sorted(p.name for p in path.iterdir() if p.suffix in ('.mcap', '.db3'))
-        if storage:
-            msg = f'{str(path)!r} has {", ".join(storage)} but no metadata.yaml: the ' \
-                  'recording did not finish (a killed run?); `ros2 bag reindex` or ' \
-                  '`mcap recover` may rescue it'
-        else:
-            msg = f'{str(path)!r} is not a rosbag2 directory (no metadata.yaml)'
-        raise BagError(msg)
-    if path.is_dir():
-        check_metadata(path / 'metadata.yaml')
+    check_bag_path(path)
     try:
         reader = Reader(path)
         reader.open()
