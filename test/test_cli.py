@@ -62,6 +62,22 @@ def test_bad_storage_is_usage_error(tmp_path: Path):
     assert exc.value.code == 2
 
 
+@pytest.mark.parametrize('args, message', [
+    (['run', 'moving_force_beam', '--storage', 'zip'], 'argument --storage: invalid choice: '
+     "'zip' (choose from 'mcap', 'sqlite3'); see `ttb-sim run --help`"),
+    ([], 'the following arguments are required: COMMAND; see `ttb-sim --help`'),
+    (['run', 'x', '--duration', 'abc'], "argument --duration: invalid float value: 'abc'; see "
+     '`ttb-sim run --help`'),
+    (['sweep', 'x', '--speeds-kmh', '1', '--workers', '1', '--scheduler', 'y'],
+     'argument --scheduler: not allowed with argument --workers; see `ttb-sim sweep --help`'),
+])
+def test_usage_errors_are_one_line(capsys, args, message):
+    with pytest.raises(SystemExit) as exc:
+        main(args)
+    assert exc.value.code == 2
+    assert capsys.readouterr().err == f'ttb-sim: error: {message}\n'
+
+
 def test_refuses_to_overwrite(tmp_path: Path, capsys):
     out = tmp_path / 'exists'
     out.mkdir()

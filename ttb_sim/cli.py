@@ -19,7 +19,9 @@ The verbs themselves live in :mod:`ttb_sim.commands` (ROS-free, callable from
 tests and the node).
 
 Exit codes: 0 success; 1 numerical failure (divergence) or failed validation;
-2 bad scenario or argument; 130 / 143 interrupted by SIGINT / SIGTERM.
+2 bad scenario or argument; 130 / 143 interrupted by SIGINT / SIGTERM. Every
+refusal, a usage error of the argument parser included, is one line on stderr
+starting ``ttb-sim: error:``.
 """
 
 from __future__ import annotations
@@ -31,7 +33,7 @@ from pathlib import Path
 import re
 import sys
 import threading
-from typing import Any, Sequence
+from typing import Any, NoReturn, Sequence
 
 from ttb_sim import __version__
 from ttb_sim.commands.signals import SignalHandlers, stop_now
@@ -42,10 +44,23 @@ log = logging.getLogger('ttb_sim')
 EXIT_OK, EXIT_FAILURE, EXIT_USAGE, EXIT_INTERRUPTED = 0, 1, 2, 130
 
 
+MAX_MESSAGE = 600
+"""Longest error line printed (characters): a library's message may quote a long value."""
+
+
+class _Parser(argparse.ArgumentParser):
+    """An argument parser whose usage errors are one line (exit 2), as every other refusal."""
+
+    def error(self, message: str) -> NoReturn:
+        """Print the problem and where help is, on one line, and exit 2."""
+        text = one_line(f'{message}; see `{self.prog} --help`')
+        self.exit(EXIT_USAGE, f'ttb-sim: error: {text}\n')
+
+
 def _parser() -> argparse.ArgumentParser:
-    p = argparse.ArgumentParser(prog='ttb-sim', description='Train-track-bridge dynamics: '
-                                'run scenarios offline to rosbag2, validate the physics, '
-                                'analyse bags, sweep speeds and seeds.')
+    p = _Parser(prog='ttb-sim', description='Train-track-bridge dynamics: run scenarios '
+                'offline to rosbag2, validate the physics, analyse bags, sweep speeds and '
+                'seeds.')
     p.add_argument('--version', action='version', version=f'%(prog)s {__version__}')
     p.add_argument('-v', '--verbose', action='store_true', help='log progress details')
     sub = p.add_subparsers(dest='command', required=True, metavar='COMMAND')
@@ -175,9 +190,13 @@ def entry() -> None:
     os._exit(code)
 
 
-def one_line(exc: BaseException) -> str:
-    """Return an error's message on one line (a library's text may span several)."""
-    return re.sub(r'\s*\n\s*', ' ', str(exc).strip())
+def one_line(exc: BaseException | str) -> str:
+    """Return an error's message on one line, cut to :data:`MAX_MESSAGE` characters."""
+    text = re.sub(r'\s*\n\s*', ' ', str(exc).strip())
+    if len(text) > MAX_MESSAGE:
+        half = MAX_MESSAGE // 2
+        text = f'{text[:half]}...{text[-half:]} ({len(text)} characters)'
+    return text
 
 
 def _main(argv: Sequence[str] | None) -> int:
