@@ -287,6 +287,38 @@ def test_a_short_csv_of_good_cells_is_refused_for_its_rows(tmp_path):
         load_csv(path)
 
 
+def test_a_name_too_long_for_the_file_system_is_refused(tmp_path, capsys):
+    """Found by the fuzz suite: Path.is_file() raises for ENAMETOOLONG (not for ENOENT)."""
+    err = _cli(tmp_path, capsys, 'x' * 300)
+    assert err.startswith("ttb-sim: error: scenario file 'xxxxx") and \
+        err.endswith('cannot be reached (File name too long)\n')
+    assert main(['analyze', 'y' * 300]) == 2
+    assert capsys.readouterr().err.endswith('cannot be reached (File name too long)\n')
+    (tmp_path / 'loop').symlink_to('loop')
+    assert main(['analyze', str(tmp_path / 'bag'), '--out', str(tmp_path / 'loop' / 'a')]) == 2
+    assert 'does not exist' in capsys.readouterr().err   # the bag is checked first
+    assert main(['analyze', str(tmp_path / 'loop')]) == 2
+    assert capsys.readouterr().err.endswith('cannot be reached (Too many levels of symbolic '
+                                            'links)\n')
+
+
+def test_control_characters_of_a_value_stay_on_one_line(capsys):
+    """Found by the fuzz suite: a record separator in a case name split the message."""
+    assert main(['validate', 'a\x1eb\u2028c']) == 2
+    err = capsys.readouterr().err
+    assert err.startswith('ttb-sim: error: unknown validation case(s) a\\x1eb\\u2028c; allowed')
+    assert len(err.splitlines()) == 1
+
+
+def test_a_span_too_short_for_finite_beam_elements_is_refused(tmp_path, capsys):
+    """Found by the fuzz suite: 2e-282 m is in (0, 500] but its elements' L^3 is 0."""
+    err = _cli(tmp_path, capsys, 'moving_force_beam', '--duration', '0.002', '--set',
+               'bridge.span_length=2.0273994802272575e-282')
+    assert err.startswith('ttb-sim: error: bridge.span_length = 2.0274e-282 m over '
+                          'bridge.elements_per_span = 16 gives beam elements of 1.26712e-283 m')
+    assert err.endswith('is not a finite number: give a span of a bridge (metres)\n')
+
+
 def test_read_user_file_reads_a_small_regular_file(tmp_path):
     path = tmp_path / 'a.txt'
     path.write_text('hello')

@@ -27,6 +27,7 @@ starting ``ttb-sim: error:``.
 from __future__ import annotations
 
 import argparse
+import errno
 import logging
 import os
 from pathlib import Path
@@ -191,12 +192,37 @@ def entry() -> None:
 
 
 def one_line(exc: BaseException | str) -> str:
-    """Return an error's message on one line, cut to :data:`MAX_MESSAGE` characters."""
+    """
+    Return an error's message on one line, cut to :data:`MAX_MESSAGE` characters.
+
+    Line breaks (a library's text may span several lines) become spaces; other
+    control characters, which a user value may carry into the message and a
+    terminal may take for a line break (the record and Unicode line separators), are
+    escaped as in ``repr``.
+    """
     text = re.sub(r'\s*\n\s*', ' ', str(exc).strip())
+    text = ''.join(c if c.isprintable() else repr(c)[1:-1] for c in text)
     if len(text) > MAX_MESSAGE:
         half = MAX_MESSAGE // 2
         text = f'{text[:half]}...{text[-half:]} ({len(text)} characters)'
     return text
+
+
+_PATH_ERRORS = frozenset({errno.ENAMETOOLONG, errno.ENOENT, errno.ENOTDIR, errno.EISDIR,
+                          errno.EACCES, errno.EPERM, errno.EROFS, errno.ELOOP, errno.EEXIST,
+                          errno.EINVAL})
+"""errno values that say a path given cannot be used: exit 2, like any bad argument."""
+
+
+def _os_error(exc: OSError) -> int:
+    """Print an OSError in one line (the files named); exit 2 for a bad path, else 1."""
+    names = ' and '.join(repr(str(f)) for f in (exc.filename, exc.filename2) if f is not None)
+    what = f'{names}: {exc.strerror or exc}' if names else str(exc.strerror or exc)
+    if exc.errno in _PATH_ERRORS:
+        print(f'ttb-sim: error: {one_line(what)}', file=sys.stderr)
+        return EXIT_USAGE
+    print(f'ttb-sim: failed: {one_line(what)}', file=sys.stderr)
+    return EXIT_FAILURE
 
 
 def _main(argv: Sequence[str] | None) -> int:
@@ -243,6 +269,8 @@ def _main(argv: Sequence[str] | None) -> int:
     except TtbSimError as exc:
         print(f'ttb-sim: failed: {one_line(exc)}', file=sys.stderr)
         return EXIT_FAILURE
+    except OSError as exc:  # a path the verb did not check itself (a name too long, say)
+        return _os_error(exc)
     except BrokenPipeError:  # stdout closed early (`ttb-sim scenarios | head`): not an error
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
         return EXIT_OK

@@ -252,12 +252,17 @@ def resolve(source: str | Path) -> Path:
     """
     path = Path(source)
     yaml_name = path.suffix in ('.yaml', '.yml')
-    if path.is_file() or (yaml_name and not path.is_dir()):
+    try:
+        is_file, is_dir, exists = path.is_file(), path.is_dir(), path.exists()
+    except OSError as exc:  # a name too long for the file system, say
+        message = f'scenario file {shown(str(source))} cannot be reached ({exc.strerror})'
+        raise ScenarioError(message) from None
+    if is_file or (yaml_name and not is_dir):
         return path  # read_user_file refuses what is missing or not a regular file
     builtins = builtin_scenarios()
     if not yaml_name and str(source) in builtins:
         return builtins[str(source)]  # a folder named like a built-in does not hide it
-    if path.exists():
+    if exists:
         read_user_file(path, 'scenario file', MAX_SCENARIO_BYTES)  # says what it is instead
     names = ', '.join(sorted(builtins)) or '(none found)'
     raise ScenarioError(f'no scenario {shown(str(source))}: give a YAML path or a built-in '

@@ -72,8 +72,13 @@ def check_bag_path(path: Path) -> None:
         ``metadata.yaml`` that :func:`check_metadata` refuses.
 
     """
-    if not path.exists():
-        raise BagError(f'bag {str(path)!r} does not exist')
+    try:
+        path.stat()
+    except FileNotFoundError:
+        raise BagError(f'bag {str(path)!r} does not exist') from None
+    except (OSError, ValueError) as exc:   # a name too long, a NUL byte, a loop of links
+        reason = exc.strerror if isinstance(exc, OSError) and exc.strerror else str(exc)
+        raise BagError(f'bag {one_line(repr(str(path)))} cannot be reached ({reason})') from None
     if path.is_file():
         if path.suffix not in ('.mcap', '.db3'):
             msg = f'{str(path)!r} is not a bag: give its directory (with metadata.yaml) or ' \

@@ -48,6 +48,13 @@ class FigureNote:
 
 def check_output(out: Path) -> None:
     """Refuse an output folder that cannot be (re)written, before any work is done."""
+    try:
+        out.stat()
+    except FileNotFoundError:
+        pass
+    except (OSError, ValueError) as exc:   # a name too long, a NUL byte, a loop of links
+        reason = exc.strerror if isinstance(exc, OSError) and exc.strerror else str(exc)
+        raise ScenarioError(f'--out {str(out)!r} cannot be used ({reason})') from None
     if out.exists() and not out.is_dir():
         raise ScenarioError(f'--out {str(out)!r} is a file; give a folder to write the '
                             'figures, metrics.json and index.html into')
