@@ -78,6 +78,14 @@ def test_usage_errors_are_one_line(capsys, args, message):
     assert capsys.readouterr().err == f'ttb-sim: error: {message}\n'
 
 
+def test_a_path_error_a_verb_did_not_check_is_one_line(tmp_path: Path, capsys):
+    """The command line's last net: an OSError for a path given is exit 2, one line."""
+    (tmp_path / 'file.txt').write_text('x')
+    out = tmp_path / 'file.txt' / 'sweep'
+    assert main(['sweep', 'moving_force_beam', '--speeds-kmh', '1', '--out', str(out)]) == 2
+    assert capsys.readouterr().err == f'ttb-sim: error: {str(out)!r}: Not a directory\n'
+
+
 def test_refuses_to_overwrite(tmp_path: Path, capsys):
     out = tmp_path / 'exists'
     out.mkdir()

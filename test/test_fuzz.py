@@ -13,10 +13,10 @@
 # limitations under the License.
 
 """
-Fuzzing the inputs of ``ttb-sim run`` with hypothesis: nothing may crash, hang or half-write.
+Fuzzing the inputs of ``ttb-sim`` with hypothesis: nothing may crash, hang or half-write.
 
-Four input kinds, each drawn by hypothesis from a strategy that mixes plausible
-and hostile values:
+Six input kinds, each drawn by hypothesis from a strategy that mixes plausible
+and hostile values (``fuzz_inputs.py``):
 
 * scenario mappings (keys of the schema and junk keys, values in and out of
   range, wrong types, nested junk): 200 examples validated, 40 run;
@@ -25,33 +25,33 @@ and hostile values:
   odd scalars): 200 examples;
 * irregularity CSV bytes (headers, numbers including nan, inf and huge ones,
   ragged rows, quotes, BOM and NUL bytes, random bytes): 200 examples read,
-  30 run under a quarter car.
-
-and through the command line itself (in-process, :func:`ttb_sim.cli.main`):
-
-* ``ttb-sim run BASE --set KEY=VALUE ...``: every key of the schema (and
-  sections and junk keys), values that must be refused for any key and any
+  30 run under a quarter car;
+* command lines ``ttb-sim run BASE --set KEY=VALUE ...`` through
+  :func:`ttb_sim.cli.main` in this process: every key of the schema (and
+  sections and junk keys) with a value its declaration must refuse, and any
   value for the cheap keys, run for a few steps: 120 examples;
-* argument vectors of every verb (its own options, values, paths to missing
-  files, broken and truncated bags, NUL bytes, junk): 300 examples, with the
-  expensive step after the argument checks of each verb replaced by a stub
-  (building and stepping a model, running the validation suite or a sweep,
-  measuring a benchmark, computing a bag's metrics);
-* a few of those as subprocesses of ``python -m ttb_sim.cli``.
+* argument vectors of every verb (its options, values, missing files, long
+  names, link loops, broken and truncated bags, NUL bytes, junk), with the
+  expensive step after each verb's argument checks replaced by a stub
+  (building or stepping a model, the validation suite, a sweep's workers, a
+  benchmark run, a bag's metrics): 300 examples; and a few refusals as
+  subprocesses of ``python -m ttb_sim.cli``.
 
-That is 1290 examples per run of this module (each test's id and a line printed
-at the end of the module, visible with ``-s``, give its count). Every example
-must end like the command line does: a scenario or profile, or a ScenarioError (exit 2) with a
-short message; the runs must exit 0, 1 (divergence) or 2 with a one-line
-message, and leave either no output directory (exit 2) or a closed bag with
-``summary.json`` (0, 1). Any other exception, a message without the
-``ttb-sim:`` prefix or a long message fails. Hangs are bounded by the
-per-example ``deadline`` (a bound against hangs, not a speed check: it is
-generous for a loaded 2-core machine) and, for the command line, by an alarm
-that stops an example after :data:`HANG_SECONDS`. Runs stay tiny: the base scenario is
-``moving_force_beam`` or ``sprung_mass_beam`` and ``--duration`` is at most 5 ms
-at a step of at least 0.1 ms. The examples are derandomised, so CI tries the
-same ones every time; raise ``max_examples`` locally to search further.
+That is 1290 examples per run of this module: each test's id carries its count
+and a line printed at the end of the module (visible with ``-s``) gives the
+examples run and their outcomes. Every example must end like the command line
+does: a scenario or profile, or a ScenarioError (exit 2) with a short message;
+the command lines exit 0, 1 (divergence) or 2 with a one-line message and no
+traceback, and a refusal writes nothing (the runs leave either no output
+directory or a closed bag with ``summary.json``). Any other exception, a
+message without the ``ttb-sim:`` prefix or a long message fails. Hangs are
+bounded by the per-example ``deadline`` (a bound against hangs, not a speed
+check: it is generous for a loaded 2-core machine) and, for the command line,
+by an alarm that stops an example after :data:`HANG_SECONDS`. Runs stay tiny:
+the base scenario is ``moving_force_beam`` or ``sprung_mass_beam`` and
+``--duration`` is at most 5 ms at a step of at least 0.1 ms. The examples are
+derandomised, so CI tries the same ones every time; raise ``max_examples``
+locally to search further.
 """
 
 from __future__ import annotations
