@@ -40,6 +40,16 @@ def test_bad_input_exit_2_nothing_written(tmp_path: Path, capsys, args, match):
     assert not out.exists()
 
 
+def test_a_section_given_to_set_is_named_as_a_section(tmp_path: Path, capsys):
+    out = tmp_path / 'out'
+    assert main(['run', 'moving_force_beam', '--out', str(out), '--set', 'train=5']) == 2
+    assert capsys.readouterr().err == (
+        'ttb-sim: error: train = 5: train is a section, not a value; set one of its keys, e.g. '
+        'train.speed_kmh (its 11 keys: train.vehicle, train.speed_kmh, train.start_position, '
+        'train.axle_offsets, ...; see `ttb-sim scenarios --keys`)\n')
+    assert not out.exists()
+
+
 def test_unreadable_scenario_exit_2(tmp_path: Path, capsys):
     assert main(['run', str(tmp_path / 'missing.yaml'), '--out', str(tmp_path / 'o')]) == 2
     assert 'does not exist' in capsys.readouterr().err
@@ -50,6 +60,30 @@ def test_bad_storage_is_usage_error(tmp_path: Path):
     with pytest.raises(SystemExit) as exc:
         main(['run', 'moving_force_beam', '--storage', 'zip', '--out', str(tmp_path / 'o')])
     assert exc.value.code == 2
+
+
+@pytest.mark.parametrize('args, message', [
+    (['run', 'moving_force_beam', '--storage', 'zip'], 'argument --storage: invalid choice: '
+     "'zip' (choose from 'mcap', 'sqlite3'); see `ttb-sim run --help`"),
+    ([], 'the following arguments are required: COMMAND; see `ttb-sim --help`'),
+    (['run', 'x', '--duration', 'abc'], "argument --duration: invalid float value: 'abc'; see "
+     '`ttb-sim run --help`'),
+    (['sweep', 'x', '--speeds-kmh', '1', '--workers', '1', '--scheduler', 'y'],
+     'argument --scheduler: not allowed with argument --workers; see `ttb-sim sweep --help`'),
+])
+def test_usage_errors_are_one_line(capsys, args, message):
+    with pytest.raises(SystemExit) as exc:
+        main(args)
+    assert exc.value.code == 2
+    assert capsys.readouterr().err == f'ttb-sim: error: {message}\n'
+
+
+def test_a_path_error_a_verb_did_not_check_is_one_line(tmp_path: Path, capsys):
+    """The command line's last net: an OSError for a path given is exit 2, one line."""
+    (tmp_path / 'file.txt').write_text('x')
+    out = tmp_path / 'file.txt' / 'sweep'
+    assert main(['sweep', 'moving_force_beam', '--speeds-kmh', '1', '--out', str(out)]) == 2
+    assert capsys.readouterr().err == f'ttb-sim: error: {str(out)!r}: Not a directory\n'
 
 
 def test_refuses_to_overwrite(tmp_path: Path, capsys):

@@ -13,10 +13,10 @@
 # limitations under the License.
 
 """
-Fuzzing the inputs of ``ttb-sim run`` with hypothesis: nothing may crash, hang or half-write.
+Fuzzing the inputs of ``ttb-sim`` with hypothesis: nothing may crash, hang or half-write.
 
-Four input kinds, each drawn by hypothesis from a strategy that mixes plausible
-and hostile values:
+Six input kinds, each drawn by hypothesis from a strategy that mixes plausible
+and hostile values (``fuzz_inputs.py``):
 
 * scenario mappings (keys of the schema and junk keys, values in and out of
   range, wrong types, nested junk): 200 examples validated, 40 run;
@@ -25,37 +25,62 @@ and hostile values:
   odd scalars): 200 examples;
 * irregularity CSV bytes (headers, numbers including nan, inf and huge ones,
   ragged rows, quotes, BOM and NUL bytes, random bytes): 200 examples read,
-  30 run under a quarter car.
+  30 run under a quarter car;
+* command lines ``ttb-sim run BASE --set KEY=VALUE ...`` through
+  :func:`ttb_sim.cli.main` in this process: every key of the schema (and
+  sections and junk keys) with a value its declaration must refuse, and any
+  value for the cheap keys, run for a few steps: 120 examples;
+* argument vectors of every verb (its options, values, missing files, long
+  names, link loops, broken and truncated bags, NUL bytes, junk), with the
+  expensive step after each verb's argument checks replaced by a stub
+  (building or stepping a model, the validation suite, a sweep's workers, a
+  benchmark run, a bag's metrics): 300 examples; and a few refusals as
+  subprocesses of ``python -m ttb_sim.cli``.
 
-That is 870 examples per run of this module. Every example must end like the
-command line does: a scenario or profile, or a ScenarioError (exit 2) with a
-short message; the runs must exit 0, 1 (divergence) or 2 with a one-line
-message, and leave either no output directory (exit 2) or a closed bag with
-``summary.json`` (0, 1). Any other exception, a message without the
-``ttb-sim:`` prefix or a long message fails. Hangs are bounded by the
-per-example ``deadline`` (a bound against hangs, not a speed check: it is
-generous for a loaded 2-core machine). Runs stay tiny: the base scenario is
-``moving_force_beam`` or ``sprung_mass_beam`` and ``--duration`` is at most 5 ms
-at a step of at least 0.1 ms. The examples are derandomised, so CI tries the
-same ones every time; raise ``max_examples`` locally to search further.
+That is 1290 examples per run of this module: each test's id carries its count
+and a line printed at the end of the module (visible with ``-s``) gives the
+examples run and their outcomes. Every example must end like the command line
+does: a scenario or profile, or a ScenarioError (exit 2) with a short message;
+the command lines exit 0, 1 (divergence) or 2 with a one-line message and no
+traceback, and a refusal writes nothing (the runs leave either no output
+directory or a closed bag with ``summary.json``). Any other exception, a
+message without the ``ttb-sim:`` prefix or a long message fails. Hangs are
+bounded by the per-example ``deadline`` (a bound against hangs, not a speed
+check: it is generous for a loaded 2-core machine) and, for the command line,
+by an alarm that stops an example after :data:`HANG_SECONDS`. Runs stay tiny:
+the base scenario is ``moving_force_beam`` or ``sprung_mass_beam`` and
+``--duration`` is at most 5 ms at a step of at least 0.1 ms. The examples are
+derandomised, so CI tries the same ones every time; raise ``max_examples``
+locally to search further.
 """
 
 from __future__ import annotations
 
+import collections
 import contextlib
 from datetime import timedelta
+import functools
 import io
 import json
 import math
+import os
 from pathlib import Path
+import shutil
+import signal
+import subprocess
+import sys
 import tempfile
-from typing import Any
+import time
+from typing import Any, Callable, Iterator
+from unittest import mock
 
+from fuzz_inputs import (argvs, CHEAP_KEYS, csv_bytes, flow, key_values, KEYS, merge, nest,
+                         options, refused_pairs, SET_VALUES, YAML_TOKENS)
 from hypothesis import event, given, HealthCheck, settings, strategies as st
 from hypothesis.control import currently_in_test_context
 import pytest
-from ttb_sim.cli import main
-from ttb_sim.config import iter_keys, load_scenario, parse_override, Scenario
+from ttb_sim.cli import _parser, main
+from ttb_sim.config import load_scenario, parse_override, Scenario
 from ttb_sim.errors import ScenarioError
 from ttb_sim.model.irregularity import load_csv, TrackIrregularity
 import yaml
@@ -63,76 +88,57 @@ import yaml
 MAX_MESSAGE = 2000
 """Longest acceptable error message (characters)."""
 
+HANG_SECONDS = 60
+"""An example of the command line still running after this long has hung (an alarm ends it)."""
+
 VALIDATE = settings(max_examples=200, deadline=timedelta(seconds=30), derandomize=True,
                     database=None, suppress_health_check=[HealthCheck.too_slow])
 RUN = settings(max_examples=40, deadline=timedelta(seconds=120), derandomize=True,
                database=None, suppress_health_check=[HealthCheck.too_slow])
 RUN_CSV = settings(RUN, max_examples=30)
+SET_CLI = settings(RUN, max_examples=120)
+ARGV = settings(VALIDATE, max_examples=300)
 
-KEYS = [(key, typ, spec) for key, typ, _, spec in iter_keys()]
-SECTIONS = sorted({key.split('.')[0] for key, _, _ in KEYS if '.' in key})
-
-# -- value strategies ------------------------------------------------------------------------
-
-SCALARS = st.one_of(
-    st.none(), st.booleans(), st.integers(-10**6, 10**6), st.integers(),
-    st.floats(allow_nan=True, allow_infinity=True), st.text(max_size=12),
-    st.text(max_size=300), st.sampled_from(['', 'car', 'slab', 'none', 'springs', 'paper',
-                                            'a=girder@1', 'x=rail_left@0', '1e6', '.nan']))
-JUNK = st.recursive(SCALARS, lambda inner: st.lists(inner, max_size=4)
-                    | st.dictionaries(st.text(max_size=8), inner, max_size=4), max_leaves=12)
+EXAMPLES: dict[str, collections.Counter[str]] = collections.defaultdict(collections.Counter)
+"""Examples run and their outcomes per test, printed at the end of the module (``-s``)."""
+_CURRENT = ['']
 
 
-def _plausible(typ: Any, spec: Any) -> st.SearchStrategy[Any]:
-    """Values near the declared range: mostly accepted, sometimes just outside."""
-    if spec.choices is not None:
-        return st.sampled_from(spec.choices)
-    if typ is bool:
-        return st.booleans()
-    low = -1e6 if spec.low is None else spec.low
-    high = 1e6 if spec.high is None else spec.high
-    if typ is int:
-        return st.integers(int(max(low, -10**6)) - 1, int(min(high, 10**6)) + 1)
-    if typ is float:
-        return st.floats(low, high) | st.sampled_from([low, high, low - 1.0, high * 2 + 1])
-    if typ == tuple[float, ...]:
-        return st.lists(st.floats(0.0, 100.0), max_size=5)
-    if typ == tuple[str, ...]:
-        return st.lists(st.sampled_from(['a=girder@1', 'b=girder@16', 'c=slab@3', 'bad']),
-                        max_size=3)
-    return st.text(max_size=10)
+def examples(settings_: settings) -> Any:
+    """Give a test its example count in its id: ``test_fuzz_yaml_texts[200-examples]``."""
+    n = settings_.max_examples
+    return pytest.mark.parametrize('examples', [n], ids=[f'{n}-examples'])
 
 
-@st.composite
-def key_values(draw: Any, keys: list[tuple[str, Any, Any]] = KEYS) -> tuple[str, Any]:
-    """One (dotted key, value) pair: a schema key with a plausible or junk value, or junk."""
-    if draw(st.integers(0, 9)) == 0:
-        return draw(st.sampled_from(SECTIONS + ['nope', 'bridge.nope', 'train'])), draw(JUNK)
-    key, typ, spec = draw(st.sampled_from(keys))
-    value = draw(_plausible(typ, spec)) if draw(st.integers(0, 3)) else draw(JUNK)
-    return key, value
+def counted(test: Callable[..., None]) -> Callable[..., None]:
+    """Count the examples a hypothesis test runs (below ``@given``)."""
+    @functools.wraps(test)
+    def wrapper(*args: Any, **kwargs: Any) -> None:
+        _CURRENT[0] = test.__name__
+        EXAMPLES[test.__name__]['examples'] += 1
+        test(*args, **kwargs)
+    return wrapper
 
 
-def _nest(pairs: list[tuple[str, Any]]) -> dict[str, Any]:
-    """Nest dotted keys into a mapping (a later pair replaces what is in its way)."""
-    root: dict[str, Any] = {}
-    for key, value in pairs:
-        node = root
-        parts = key.split('.')
-        for part in parts[:-1]:
-            if not isinstance(node.get(part), dict):
-                node[part] = {}
-            node = node[part]
-        node[parts[-1]] = value
-    return root
+@pytest.fixture(scope='module', autouse=True)
+def _report_examples() -> Iterator[None]:
+    """Print the examples of every test and the module's time once it has run."""
+    start = time.perf_counter()
+    yield
+    for name, counts in EXAMPLES.items():
+        outcomes = ', '.join(f'{k}: {v}' for k, v in sorted(counts.items()) if k != 'examples')
+        print(f'\nfuzz: {name}: {counts["examples"]} examples ({outcomes})', end='')
+    total = sum(c['examples'] for c in EXAMPLES.values())
+    print(f'\nfuzz: {total} examples in {time.perf_counter() - start:.1f} s')
 
 
 # -- checks ----------------------------------------------------------------------------------
 
 def _event(name: str) -> None:
-    """Count an outcome in hypothesis' statistics (--hypothesis-show-statistics)."""
+    """Count an outcome in hypothesis' statistics (--hypothesis-show-statistics) and here."""
     if currently_in_test_context():
         event(name)
+        EXAMPLES[_CURRENT[0]][name] += 1
 
 
 def _validated(load: Any) -> Any:
@@ -174,11 +180,13 @@ def _cli(args: list[str], out: Path) -> int:
 
 # -- scenario mappings -----------------------------------------------------------------------
 
+@examples(VALIDATE)
 @VALIDATE
 @given(st.lists(key_values(), max_size=8))
-def test_fuzz_scenario_mappings_validate(pairs: list[tuple[str, Any]]) -> None:
+@counted
+def test_fuzz_scenario_mappings_validate(examples: int, pairs: list[tuple[str, Any]]) -> None:
     """Any mapping loads as a scenario or is refused with a short message."""
-    data = _nest(pairs)
+    data = nest(pairs)
     with tempfile.TemporaryDirectory() as tmp:
         path = Path(tmp) / 'fuzz.yaml'
         path.write_text(yaml.safe_dump(data), encoding='utf-8')
@@ -186,26 +194,19 @@ def test_fuzz_scenario_mappings_validate(pairs: list[tuple[str, Any]]) -> None:
     assert isinstance(result, (Scenario, ScenarioError))
 
 
-CHEAP_KEYS = [(k, t, s) for k, t, s in KEYS if k in {
-    'bridge.span_length', 'bridge.bending_stiffness', 'bridge.mass_per_length',
-    'bridge.damping_ratio', 'train.speed_kmh', 'train.axle_load', 'train.start_position',
-    'train.sprung_mass', 'train.unsprung_mass', 'train.suspension_stiffness',
-    'train.suspension_damping', 'train.axle_offsets', 'irregularity.spectrum',
-    'irregularity.seed', 'irregularity.scale', 'solver.divergence_limit', 'output.rate_hz',
-    'output.observers', 'solver.variant', 'bearings.model', 'description'}]
-
-
+@examples(RUN)
 @RUN
 @given(st.lists(key_values(CHEAP_KEYS), max_size=6),
        st.sampled_from(['moving_force_beam', 'sprung_mass_beam']),
        st.floats(1e-4, 1e-3), st.floats(1e-4, 5e-3))
-def test_fuzz_scenario_mappings_run(pairs: list[tuple[str, Any]], base: str, dt: float,
-                                    duration: float) -> None:
+@counted
+def test_fuzz_scenario_mappings_run(examples: int, pairs: list[tuple[str, Any]], base: str,
+                                    dt: float, duration: float) -> None:
     """Mappings over the cheap keys of a one-span scenario, run for a few steps."""
     data = yaml.safe_load(Path(__file__).resolve().parents[1].joinpath(
         'config', f'{base}.yaml').read_text())
     for key, value in pairs:
-        data = _merge(data, _nest([(key, value)]))
+        data = merge(data, nest([(key, value)]))
     with tempfile.TemporaryDirectory() as tmp:
         path = Path(tmp) / 'fuzz.yaml'
         path.write_text(yaml.safe_dump(data), encoding='utf-8')
@@ -213,30 +214,17 @@ def test_fuzz_scenario_mappings_run(pairs: list[tuple[str, Any]], base: str, dt:
              Path(tmp) / 'out' / 'bag')
 
 
-def _merge(base: Any, extra: dict[str, Any]) -> dict[str, Any]:
-    out = dict(base) if isinstance(base, dict) else {}
-    for key, value in extra.items():
-        out[key] = _merge(out.get(key), value) if isinstance(value, dict) else value
-    return out
-
-
 # -- --set strings ---------------------------------------------------------------------------
 
-SET_VALUES = st.one_of(
-    st.text(max_size=40),
-    st.sampled_from(['1e6', '-1', '.inf', '.nan', '[1, 2]', '{a: 1}', '&a [*a]', '*a',
-                     '!!binary x', '2001-13-45', '1' * 5000, '[' * 100 + ']' * 100, 'yes',
-                     '~', '"', "'",
-                     'a: b: c', '- x', '| block', '0x1F', '1_000', '!!python/name:os.system']))
-
-
+@examples(VALIDATE)
 @VALIDATE
 @given(st.one_of(
     st.text(max_size=60),
-    key_values().map(lambda kv: f'{kv[0]}={_flow(kv[1])}'),
+    key_values().map(lambda kv: f'{kv[0]}={flow(kv[1])}'),
     st.tuples(st.sampled_from([k for k, _, _ in KEYS] + ['', 'nope', 'bridge', '.']),
               SET_VALUES).map(lambda kv: f'{kv[0]}={kv[1]}')))
-def test_fuzz_set_strings(text: str) -> None:
+@counted
+def test_fuzz_set_strings(examples: int, text: str) -> None:
     """Any --set string is applied to moving_force_beam or refused with a short message."""
     result = _validated(lambda: load_scenario('moving_force_beam', [text]))
     assert isinstance(result, (Scenario, ScenarioError))
@@ -246,27 +234,14 @@ def test_fuzz_set_strings(text: str) -> None:
         pass
 
 
-def _flow(value: Any) -> str:
-    """Write a value as one line of YAML (as a user types it after KEY=)."""
-    return yaml.safe_dump(value, default_flow_style=True, width=10**9).strip().removesuffix(
-        '\n...').replace('\n', ' ')
-
-
 # -- YAML texts ------------------------------------------------------------------------------
 
-YAML_TOKENS = st.sampled_from([
-    'bridge', 'train', 'solver', 'span_length', 'speed_kmh', 'dt', 'name', 'description',
-    'output', 'observers', ':', ': ', '\n', '\n  ', '\n    ', '- ', '[', ']', '{', '}', ',',
-    '&a ', '*a', '&b ', '*b', '<<: ', '!!binary ', '!!str ', '!!float ', '!!python/tuple ',
-    '!foo ', '? ', '|', '>', '#', '"', "'", '\\', '%YAML 1.1\n', '---\n', '...\n', '\t',
-    '1', '1e6', '-0.5', '.nan', '.inf', '0x10', '2001-12-14', '2001-13-45', '~', 'null',
-    'true', '1' * 5000, '\x00', '\ufeff', 'é', '\u2028', '@', '`'])
-
-
+@examples(VALIDATE)
 @VALIDATE
 @given(st.one_of(st.lists(YAML_TOKENS, max_size=40).map(''.join), st.text(max_size=200),
                  st.integers(1, 6000).map(lambda n: 'a: ' + '[' * n + ']' * n)))
-def test_fuzz_yaml_texts(text: str) -> None:
+@counted
+def test_fuzz_yaml_texts(examples: int, text: str) -> None:
     """Any text in a scenario file is loaded or refused with a short message, quickly."""
     with tempfile.TemporaryDirectory() as tmp:
         path = Path(tmp) / 'fuzz.yaml'
@@ -277,48 +252,11 @@ def test_fuzz_yaml_texts(text: str) -> None:
 
 # -- irregularity CSV bytes ------------------------------------------------------------------
 
-HEADERS = st.sampled_from(['x,z_left,z_right,y_left,y_right', 'x,z_left,z_right,y_left,y_right',
-                           'z_left,x,y_right,y_left,z_right',
-                           'x,z_left,z_right,y_left', 'x,z_left,z_right,y_left,y_right,note',
-                           'x,x,z_left,z_right,y_left,y_right', '', '# comment', '"x",z_left'])
-CELLS = st.one_of(
-    st.floats(allow_nan=True, allow_infinity=True).map(repr),
-    st.floats(-1e-3, 1e-3).map(repr), st.integers(-10**30, 10**30).map(str),
-    st.sampled_from(['', 'nan', 'inf', '-inf', '1e308', '1e-320', 'abc', '"', '"1"', ' 1 ',
-                     '\x00', '1e999', '0x1', '1_0']))
-
-
-@st.composite
-def csv_bytes(draw: Any) -> bytes:
-    """Draw a CSV file: a header (or none) and rows of cells, or raw bytes."""
-    if draw(st.integers(0, 4)) == 0:
-        return draw(st.binary(max_size=400))
-    clean = draw(st.booleans())  # half the files are well formed (with or without a header)
-    if clean:
-        rows = draw(st.sampled_from([['x,z_left,z_right,y_left,y_right'], [],
-                                     ['# measured', 'z_left,x,z_right,y_left,y_right']]))
-    else:
-        rows = [draw(HEADERS)]
-    n = draw(st.integers(0, 30))
-    monotone = clean or draw(st.booleans())
-    step = draw(st.sampled_from([0.25, 1e-9, 1e6, 0.1]))
-    for i in range(n):
-        if clean:
-            cells = [repr(draw(st.floats(-1e-3, 1e-3))) for _ in range(5)]
-        else:
-            width = draw(st.sampled_from([5, 5, 5, 4, 6]))
-            cells = [draw(CELLS) for _ in range(width)]
-        if monotone and cells:
-            cells[0] = repr(i * step)
-        rows.append(','.join(cells))
-    text = '\n'.join(rows) + draw(st.sampled_from(['\n', '', '\r\n']))
-    prefix = draw(st.sampled_from([b'', b'', b'', b'\xef\xbb\xbf', b'\xff']))
-    return prefix + text.encode('utf-8')
-
-
+@examples(VALIDATE)
 @VALIDATE
 @given(csv_bytes())
-def test_fuzz_irregularity_csv_bytes(data: bytes) -> None:
+@counted
+def test_fuzz_irregularity_csv_bytes(examples: int, data: bytes) -> None:
     """Any bytes are read as a finite profile or refused with a short message."""
     with tempfile.TemporaryDirectory() as tmp:
         path = Path(tmp) / 'fuzz.csv'
@@ -329,9 +267,11 @@ def test_fuzz_irregularity_csv_bytes(data: bytes) -> None:
         assert math.isfinite(result.dx) and result.dx > 0
 
 
+@examples(RUN_CSV)
 @RUN_CSV
 @given(csv_bytes(), st.floats(1e-4, 5e-3))
-def test_fuzz_irregularity_csv_runs(data: bytes, duration: float) -> None:
+@counted
+def test_fuzz_irregularity_csv_runs(examples: int, data: bytes, duration: float) -> None:
     """A quarter car on any CSV profile exits 0, 1 or 2, never half-writing."""
     with tempfile.TemporaryDirectory() as tmp:
         path = Path(tmp) / 'fuzz.csv'
@@ -359,3 +299,202 @@ def test_known_hostile_texts_stay_refused(text: str) -> None:
         path = Path(tmp) / 'f.yaml'
         path.write_text(text)
         assert isinstance(_validated(lambda: load_scenario(path)), ScenarioError)
+
+
+# -- the command line ------------------------------------------------------------------------
+
+class _Accepted(BaseException):
+    """Raised by the stub of a verb's expensive step: the verb accepted its arguments."""
+
+
+class _Hung(BaseException):
+    """Raised by the alarm: an example ran longer than HANG_SECONDS."""
+
+
+EXPENSIVE = ('ttb_sim.commands.run.make_runner', 'ttb_sim.commands.validate.run_cases',
+             'ttb_sim.commands.sweep._Local', 'ttb_sim.commands.sweep._Dask',
+             'ttb_sim.commands.bench.measure', 'ttb_sim.commands.bench.measure_isolated',
+             'ttb_sim.sim.build_structure', 'ttb_sim.report.metrics.bag_metrics')
+"""The first step of each verb after its argument checks: building or stepping a model,
+the validation suite, a sweep's workers, a benchmark run, a bag's metrics."""
+
+
+def _accept(*args: Any, **kwargs: Any) -> Any:
+    raise _Accepted()
+
+
+@contextlib.contextmanager
+def _alarm(seconds: float) -> Iterator[None]:
+    """Stop the block with _Hung after ``seconds`` (SIGALRM; the verbs handle INT and TERM)."""
+    def ring(signum: int, frame: Any) -> None:
+        raise _Hung(f'no answer after {seconds} s')
+    previous = signal.signal(signal.SIGALRM, ring)
+    signal.setitimer(signal.ITIMER_REAL, seconds)
+    try:
+        yield
+    finally:
+        signal.setitimer(signal.ITIMER_REAL, 0)
+        signal.signal(signal.SIGALRM, previous)
+
+
+def _main(argv: list[str], stub: bool) -> tuple[int | str, str]:
+    """Run ``main(argv)`` in this process: (exit code, or 'accepted' at a stub; stderr)."""
+    err = io.StringIO()
+    with contextlib.ExitStack() as stack:
+        if stub:
+            for target in EXPENSIVE:
+                stack.enter_context(mock.patch(target, _accept))
+        stack.enter_context(contextlib.redirect_stderr(err))
+        stack.enter_context(contextlib.redirect_stdout(io.StringIO()))
+        stack.enter_context(_alarm(HANG_SECONDS))
+        try:
+            code: int | str = main(argv)
+        except SystemExit as exc:   # the argument parser: usage errors, --help, --version
+            code = exc.code if isinstance(exc.code, int) else 0 if exc.code is None else 2
+        except _Accepted:
+            code = 'accepted'
+    return code, err.getvalue()
+
+
+def _tree(root: Path) -> dict[str, tuple[int, int]]:
+    """Return every path under ``root`` with its size and time of change (0, 0 for folders)."""
+    out = {}
+    for folder, dirs, files in os.walk(root):   # (links are not followed)
+        for name in dirs + files:
+            path = Path(folder, name)
+            info = path.lstat()
+            out[str(path.relative_to(root))] = (0, 0) if name in dirs else \
+                (info.st_size, info.st_mtime_ns)
+    return out
+
+
+def _answer(code: int | str, err: str, before: dict[str, tuple[int, int]],
+            after: dict[str, tuple[int, int]]) -> None:
+    """Check the property: exit 0/1/2 (or a stub reached); exit 2 is one line, writes nothing."""
+    assert code in (0, 1, 2, 'accepted'), (code, err[-2000:])
+    _event(f'exit {code}')
+    assert 'Traceback' not in err, err[-2000:]
+    lines = [line for line in err.splitlines() if line and not line.startswith('ttb-sim: plan: ')]
+    if code == 2:
+        assert len(lines) == 1 and lines[0].startswith('ttb-sim: error: '), err[-2000:]
+        assert len(lines[0]) < MAX_MESSAGE
+        assert after == before, 'exit 2 must write nothing'
+
+
+@pytest.fixture(scope='module')
+def template(tmp_path_factory: Any) -> Path:
+    """Make a working folder: scenario files, a CSV, a link loop, a tiny bag, broken bags."""
+    root = tmp_path_factory.mktemp('workspace')
+    (root / 'file.txt').write_text('not a scenario\n')
+    (root / 'empty.yaml').write_text('# nothing\n')
+    (root / 'twice.yaml').write_text('name: a\nname: b\n')
+    (root / 'bad.csv').write_text('x,z_left,z_right,y_left,y_right\n0,0,0,0,0\n1,abc,0,0,0\n')
+    (root / 'dir').mkdir()
+    (root / 'dir' / 'keep.txt').write_text('mine\n')
+    (root / 'loop').symlink_to('loop')   # a link to itself: ELOOP
+    with contextlib.redirect_stderr(io.StringIO()), contextlib.redirect_stdout(io.StringIO()):
+        assert main(['run', 'moving_force_beam', '--duration', '0.005', '--out',
+                     str(root / 'bag')]) == 0
+    storage = next((root / 'bag').glob('*.mcap'))
+    for name in ('broken_bag', 'cut_bag', 'killed_bag'):
+        shutil.copytree(root / 'bag', root / name)
+    (root / 'broken_bag' / 'metadata.yaml').write_text('rosbag2_bagfile_information: [\n')
+    cut = root / 'cut_bag' / storage.name
+    cut.write_bytes(cut.read_bytes()[:cut.stat().st_size // 2])
+    (root / 'killed_bag' / 'metadata.yaml').unlink()
+    return root
+
+
+class _Workspace:
+    """A working folder for the examples of one test, put back as it was after each example."""
+
+    def __init__(self, root: Path, template: Path | None) -> None:
+        self.root, self.template = root, template
+        self._reset()
+
+    def _reset(self) -> None:
+        shutil.rmtree(self.root, ignore_errors=True)
+        if self.template is None:
+            self.root.mkdir(parents=True)
+        else:
+            shutil.copytree(self.template, self.root, symlinks=True)
+        self.clean = _tree(self.root)
+
+    @contextlib.contextmanager
+    def example(self) -> Iterator[Path]:
+        """Run an example with the folder as the working directory; undo what it wrote."""
+        here = os.getcwd()
+        os.chdir(self.root)
+        try:
+            yield self.root
+        finally:
+            os.chdir(here)
+            if _tree(self.root) != self.clean:   # an accepted example wrote (a refusal may not)
+                self._reset()
+
+
+@pytest.fixture(scope='module')
+def workspace(template: Path, tmp_path_factory: Any) -> _Workspace:
+    """Return the working folder of the argument vectors: a copy of the template."""
+    return _Workspace(tmp_path_factory.mktemp('argv') / 'w', template)
+
+
+@pytest.fixture(scope='module')
+def empty(tmp_path_factory: Any) -> _Workspace:
+    """Return an empty working folder (the runs write their bags there)."""
+    return _Workspace(tmp_path_factory.mktemp('set') / 'w', None)
+
+
+@examples(SET_CLI)
+@SET_CLI
+@given(st.lists(st.one_of(key_values(CHEAP_KEYS).map(lambda kv: (kv[0], flow(kv[1]), False)),
+                          refused_pairs(but=('solver.duration',)).map(lambda kv: (*kv, True))),
+                min_size=1, max_size=4),
+       st.sampled_from(['moving_force_beam', 'sprung_mass_beam']), st.floats(1e-4, 3e-3))
+@counted
+def test_fuzz_cli_set_pairs(examples: int, empty: _Workspace, pairs: list[tuple[str, str, bool]],
+                            base: str, duration: float) -> None:
+    """``ttb-sim run BASE --set K=V ...``: any key refused in one line, cheap keys run."""
+    argv = ['run', base, '--duration', repr(duration), '--set', 'solver.dt=2e-4']
+    for key, value, _ in pairs:
+        argv.extend(['--set', f'{key}={value}'])
+    with empty.example() as root:
+        before = _tree(root)
+        code, err = _main([*argv, '--out', 'out/bag'], stub=False)
+        _answer(code, err, before, _tree(root))
+    if any(refused for _, _, refused in pairs):
+        assert code == 2, (pairs, err)   # a value its declaration refuses, or no such key
+    else:
+        assert code in (0, 1, 2)
+
+
+FLAGS = options(_parser())
+
+
+@examples(ARGV)
+@ARGV
+@given(argvs(FLAGS))
+@counted
+def test_fuzz_cli_argument_vectors(examples: int, workspace: _Workspace, argv: list[str]) -> None:
+    """Any argument vector of any verb: exit 0, 1 or 2 (one line, nothing written)."""
+    with workspace.example() as root:
+        before = _tree(root)
+        code, err = _main(argv, stub=True)
+        _answer(code, err, before, _tree(root))
+
+
+@pytest.mark.parametrize('argv', [
+    ['analyze', 'broken_bag'], ['analyze', 'cut_bag'],
+    ['run', 'moving_force_beam', '--set', 'train=5'], ['run', 'twice.yaml'],
+    ['sweep', 'empty.yaml', '--speeds-kmh', '1'], ['compare', 'bag'],
+    ['run', 'sprung_mass_beam', '--set', 'irregularity.file=bad.csv'], ['modes', 'a\x01b'],
+], ids=lambda argv: ' '.join(argv))
+def test_the_program_refuses_in_one_line(workspace: _Workspace, argv: list[str]) -> None:
+    """A few refusals as the installed program gives them: a subprocess, one line, exit 2."""
+    with workspace.example() as root:
+        before = _tree(root)
+        result = subprocess.run([sys.executable, '-m', 'ttb_sim.cli', *argv], cwd=root,
+                                capture_output=True, text=True, timeout=300,
+                                env={**os.environ, 'PYTHONPATH': os.pathsep.join(sys.path)})
+        _answer(result.returncode, result.stderr, before, _tree(root))
+    assert result.returncode == 2

@@ -22,6 +22,7 @@ of issue 13 (nine levels of ten aliases: 10^9 items if expanded).
 
 import os
 from pathlib import Path
+import re
 import time
 
 import pytest
@@ -107,6 +108,43 @@ def test_yaml_errors_name_the_file(tmp_path, capsys):
     err = _cli(tmp_path, capsys, str(path))
     assert '<unicode string>' not in err
     assert f'(in "{path}", line 2, column 1)' in err
+
+
+def test_a_key_given_twice_is_refused_naming_it_and_both_lines(tmp_path, capsys):
+    path = tmp_path / 'twice.yaml'
+    path.write_text('bridge:\n  span_length: 30\n  n_spans: 3\n  span_length: 25\n'
+                    'train:\n  speed_kmh: 250\n')
+    err = _cli(tmp_path, capsys, str(path))
+    assert err == (f'ttb-sim: error: scenario file {str(path)!r} is not valid YAML: key '
+                   "'bridge.span_length' is given twice, on lines 2 and 4; give it once\n")
+
+
+@pytest.mark.parametrize('text, words', [
+    ('name: a\nname: b\n', "key 'name' is given twice, on lines 1 and 2"),
+    ('train: {speed_kmh: 1, speed_kmh: 2}\n', "key 'train.speed_kmh' is given twice, on line 1, "
+     'columns 9 and 23'),
+    ('output:\n  observers: [{a: 1, a: 2}]\n', r"key 'output.observers\[0\].a' is given twice"),
+])
+def test_duplicate_keys_are_refused_at_any_depth(tmp_path, text, words):
+    path = tmp_path / 's.yaml'
+    path.write_text(text)
+    with pytest.raises(ScenarioError, match=words):
+        load_scenario(path)
+
+
+def test_a_duplicate_key_in_a_set_value_is_refused():
+    with pytest.raises(ScenarioError, match="value is not valid YAML .key 'a' is given twice"):
+        load_scenario('moving_force_beam', ['description={a: 1, a: 2}'])
+
+
+@pytest.mark.parametrize('text', ['', '\n\n', '# only a comment\n', '  # indented\n\n# two\n',
+                                  '---\n'])
+def test_an_empty_scenario_file_is_refused(tmp_path, capsys, text):
+    path = tmp_path / 'empty.yaml'
+    path.write_text(text)
+    err = _cli(tmp_path, capsys, str(path))
+    assert err.startswith(f'ttb-sim: error: scenario file {str(path)!r} is empty (no keys, '
+                          'only blank lines or comments); give the keys to set')
 
 
 @pytest.mark.parametrize('text, words', [
@@ -215,6 +253,70 @@ def test_a_huge_csv_cell_gives_a_short_message(tmp_path):
     with pytest.raises(ScenarioError, match=r'\(10000 characters\)') as info:
         load_csv(path)
     assert len(str(info.value)) < 500
+
+
+@pytest.mark.parametrize('text, message', [
+    ('x,z_left,z_right,y_left,y_right\n0,0,0,0,0\n0.25,abc,0,0,0\n',
+     "row 3: non-numeric value 'abc' in column z_left"),
+    ('0,0,0,0,0\nq,0,0,0,0\n', "row 2: non-numeric value 'q' in column x"),
+    ('y_right,x,z_left,z_right,y_left\n0,0,0,0,0\n1,0.25,0,0,\n',
+     "row 3: non-numeric value '' in column y_left"),
+    ('x,z_left,z_right,y_left,y_right\n0,0,0,0,0\n0.25,0,0,inf,0\n',
+     "row 3: value 'inf' in column y_left is not a finite number"),
+    ('x,z_left,z_right,y_left,y_right\n0,0,0,0\n', 'row 2: expected 5 fields as in the header'),
+])
+def test_a_short_csv_with_a_bad_cell_names_the_cell(tmp_path, capsys, text, message):
+    path = tmp_path / 'short.csv'
+    path.write_text(text)
+    err = _cli(tmp_path, capsys, 'sprung_mass_beam', '--duration', '0.01', '--set',
+               f'irregularity.file={path}')
+    assert message in err and 'too few rows' not in err
+    with pytest.raises(ScenarioError, match=f'^{re.escape(str(path))}: {re.escape(message)}'):
+        load_csv(path)
+
+
+def test_a_short_csv_of_good_cells_is_refused_for_its_rows(tmp_path):
+    path = tmp_path / 'short.csv'
+    path.write_text('x,z_left,z_right,y_left,y_right\n0,0,0,0,0\n0.25,0,0,0,0\n')
+    with pytest.raises(ScenarioError, match=r'row 3: too few rows: 2 data row\(s\) \(last data '
+                       r'row 3\), need at least 4'):
+        load_csv(path)
+    path.write_text('x,z_left,z_right,y_left,y_right\n# no data\n')
+    with pytest.raises(ScenarioError, match=r'row 1: too few rows: 0 data row\(s\) \(no data '
+                       r'rows\)'):
+        load_csv(path)
+
+
+def test_a_name_too_long_for_the_file_system_is_refused(tmp_path, capsys):
+    """Found by the fuzz suite: Path.is_file() raises for ENAMETOOLONG (not for ENOENT)."""
+    err = _cli(tmp_path, capsys, 'x' * 300)
+    assert err.startswith("ttb-sim: error: scenario file 'xxxxx") and \
+        err.endswith('cannot be reached (File name too long)\n')
+    assert main(['analyze', 'y' * 300]) == 2
+    assert capsys.readouterr().err.endswith('cannot be reached (File name too long)\n')
+    (tmp_path / 'loop').symlink_to('loop')
+    assert main(['analyze', str(tmp_path / 'bag'), '--out', str(tmp_path / 'loop' / 'a')]) == 2
+    assert 'does not exist' in capsys.readouterr().err   # the bag is checked first
+    assert main(['analyze', str(tmp_path / 'loop')]) == 2
+    assert capsys.readouterr().err.endswith('cannot be reached (Too many levels of symbolic '
+                                            'links)\n')
+
+
+def test_control_characters_of_a_value_stay_on_one_line(capsys):
+    """Found by the fuzz suite: a record separator in a case name split the message."""
+    assert main(['validate', 'a\x1eb\u2028c']) == 2
+    err = capsys.readouterr().err
+    assert err.startswith('ttb-sim: error: unknown validation case(s) a\\x1eb\\u2028c; allowed')
+    assert len(err.splitlines()) == 1
+
+
+def test_a_span_too_short_for_finite_beam_elements_is_refused(tmp_path, capsys):
+    """Found by the fuzz suite: 2e-282 m is in (0, 500] but its elements' L^3 is 0."""
+    err = _cli(tmp_path, capsys, 'moving_force_beam', '--duration', '0.002', '--set',
+               'bridge.span_length=2.0273994802272575e-282')
+    assert err.startswith('ttb-sim: error: bridge.span_length = 2.0274e-282 m over '
+                          'bridge.elements_per_span = 16 gives beam elements of 1.26712e-283 m')
+    assert err.endswith('is not a finite number: give a span of a bridge (metres)\n')
 
 
 def test_read_user_file_reads_a_small_regular_file(tmp_path):

@@ -19,18 +19,22 @@ The verbs themselves live in :mod:`ttb_sim.commands` (ROS-free, callable from
 tests and the node).
 
 Exit codes: 0 success; 1 numerical failure (divergence) or failed validation;
-2 bad scenario or argument; 130 / 143 interrupted by SIGINT / SIGTERM.
+2 bad scenario or argument; 130 / 143 interrupted by SIGINT / SIGTERM. Every
+refusal, a usage error of the argument parser included, is one line on stderr
+starting ``ttb-sim: error:``.
 """
 
 from __future__ import annotations
 
 import argparse
+import errno
 import logging
 import os
 from pathlib import Path
+import re
 import sys
 import threading
-from typing import Any, Sequence
+from typing import Any, NoReturn, Sequence
 
 from ttb_sim import __version__
 from ttb_sim.commands.signals import SignalHandlers, stop_now
@@ -41,10 +45,23 @@ log = logging.getLogger('ttb_sim')
 EXIT_OK, EXIT_FAILURE, EXIT_USAGE, EXIT_INTERRUPTED = 0, 1, 2, 130
 
 
+MAX_MESSAGE = 600
+"""Longest error line printed (characters): a library's message may quote a long value."""
+
+
+class _Parser(argparse.ArgumentParser):
+    """An argument parser whose usage errors are one line (exit 2), as every other refusal."""
+
+    def error(self, message: str) -> NoReturn:
+        """Print the problem and where help is, on one line, and exit 2."""
+        text = one_line(f'{message}; see `{self.prog} --help`')
+        self.exit(EXIT_USAGE, f'ttb-sim: error: {text}\n')
+
+
 def _parser() -> argparse.ArgumentParser:
-    p = argparse.ArgumentParser(prog='ttb-sim', description='Train-track-bridge dynamics: '
-                                'run scenarios offline to rosbag2, validate the physics, '
-                                'analyse bags, sweep speeds and seeds.')
+    p = _Parser(prog='ttb-sim', description='Train-track-bridge dynamics: run scenarios '
+                'offline to rosbag2, validate the physics, analyse bags, sweep speeds and '
+                'seeds.')
     p.add_argument('--version', action='version', version=f'%(prog)s {__version__}')
     p.add_argument('-v', '--verbose', action='store_true', help='log progress details')
     sub = p.add_subparsers(dest='command', required=True, metavar='COMMAND')
@@ -175,6 +192,40 @@ def entry() -> None:
     os._exit(code)
 
 
+def one_line(exc: BaseException | str) -> str:
+    """
+    Return an error's message on one line, cut to :data:`MAX_MESSAGE` characters.
+
+    Line breaks (a library's text may span several lines) become spaces; other
+    control characters, which a user value may carry into the message and a
+    terminal may take for a line break (the record and Unicode line separators), are
+    escaped as in ``repr``.
+    """
+    text = re.sub(r'\s*\n\s*', ' ', str(exc).strip())
+    text = ''.join(c if c.isprintable() else repr(c)[1:-1] for c in text)
+    if len(text) > MAX_MESSAGE:
+        half = MAX_MESSAGE // 2
+        text = f'{text[:half]}...{text[-half:]} ({len(text)} characters)'
+    return text
+
+
+_PATH_ERRORS = frozenset({errno.ENAMETOOLONG, errno.ENOENT, errno.ENOTDIR, errno.EISDIR,
+                          errno.EACCES, errno.EPERM, errno.EROFS, errno.ELOOP, errno.EEXIST,
+                          errno.EINVAL})
+"""errno values that say a path given cannot be used: exit 2, like any bad argument."""
+
+
+def _os_error(exc: OSError) -> int:
+    """Print an OSError in one line (the files named); exit 2 for a bad path, else 1."""
+    names = ' and '.join(repr(str(f)) for f in (exc.filename, exc.filename2) if f is not None)
+    what = f'{names}: {exc.strerror or exc}' if names else str(exc.strerror or exc)
+    if exc.errno in _PATH_ERRORS:
+        print(f'ttb-sim: error: {one_line(what)}', file=sys.stderr)
+        return EXIT_USAGE
+    print(f'ttb-sim: failed: {one_line(what)}', file=sys.stderr)
+    return EXIT_FAILURE
+
+
 def _main(argv: Sequence[str] | None) -> int:
     parser = _parser()
     args = parser.parse_args(argv)
@@ -214,11 +265,13 @@ def _main(argv: Sequence[str] | None) -> int:
         from ttb_sim.commands.scenarios import scenarios
         return scenarios(keys=args.keys)
     except (ScenarioError, ModelError) as exc:
-        print(f'ttb-sim: error: {exc}', file=sys.stderr)
+        print(f'ttb-sim: error: {one_line(exc)}', file=sys.stderr)
         return EXIT_USAGE
     except TtbSimError as exc:
-        print(f'ttb-sim: failed: {exc}', file=sys.stderr)
+        print(f'ttb-sim: failed: {one_line(exc)}', file=sys.stderr)
         return EXIT_FAILURE
+    except OSError as exc:  # a path the verb did not check itself (a name too long, say)
+        return _os_error(exc)
     except BrokenPipeError:  # stdout closed early (`ttb-sim scenarios | head`): not an error
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
         return EXIT_OK

@@ -27,6 +27,8 @@ from __future__ import annotations
 import csv
 import json
 import math
+import re
+import shutil
 import subprocess
 import sys
 
@@ -34,6 +36,8 @@ import numpy as np
 import pytest
 
 from ttb_sim.cli import main
+from ttb_sim.commands.compare import default_labels
+from ttb_sim.commands.sweep_case import case_row
 from ttb_sim.io.streams import load_streams
 from ttb_sim.io.topics import topic_table
 from ttb_sim.report.metrics import bag_metrics, flatten
@@ -197,6 +201,140 @@ def test_bad_input_exit_2_without_traceback(bag, tmp_path, capsys):
     assert [p.name for p in busy.iterdir()] == ['thesis.tex']
     for folder in (not_bag, truncated, killed, empty):
         assert not (folder / 'analysis').exists()
+
+
+def test_a_broken_metadata_file_is_one_line_exit_2(bag, tmp_path, capsys):
+    """Issue #28 5.5: what is wrong with which file, in one line; no advice to recover."""
+    broken = tmp_path / 'broken'
+    broken.mkdir()
+    (broken / 'metadata.yaml').write_text('rosbag2_bagfile_information: [\n')
+    for data in bag.glob('*.mcap'):
+        (broken / data.name).write_bytes(data.read_bytes())
+    assert main(['analyze', str(broken)]) == 2
+    err = capsys.readouterr().err
+    # libyaml words the problem 'did not find expected node content', PyYAML's Python parser
+    # 'expected the node content, but found ...'
+    assert re.fullmatch(f"ttb-sim: error: bag metadata '{re.escape(str(broken))}/metadata.yaml' "
+                        r'is not valid YAML: while parsing a flow node; [^\n]*node content[^\n]* '
+                        r'\(line 2, column 1\)\n', err), err
+    assert not (broken / 'analysis').exists()
+    result = run_cli('analyze', str(broken))
+    assert (result.returncode, result.stderr) == (2, err)
+
+
+def test_a_cut_mcap_points_to_recovery_in_one_line(bag, tmp_path, capsys):
+    cut = tmp_path / 'cut'
+    cut.mkdir()
+    (cut / 'metadata.yaml').write_bytes((bag / 'metadata.yaml').read_bytes())
+    data = next(bag.glob('*.mcap'))
+    (cut / data.name).write_bytes(data.read_bytes()[:len(data.read_bytes()) // 3])
+    assert main(['analyze', str(cut)]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith(f"ttb-sim: error: bag '{cut}' is truncated or corrupt "
+                          f"('{cut / data.name}': ")
+    assert err.endswith('; a recording that was killed leaves such a file: `mcap recover` may '
+                        'rescue it\n')
+    assert err.count('\n') == 1
+
+
+@pytest.fixture(scope='module')
+def quarter_cars(tmp_path_factory):
+    """Two 0.1 s quarter-car runs in folders both named ``bag`` (at 100 and 120 km/h)."""
+    root = tmp_path_factory.mktemp('qc')
+    bags = []
+    for folder, speed in (('a', '100'), ('b', '120')):
+        bag = root / folder / 'bag'
+        assert main(['run', 'sprung_mass_beam', '--duration', '0.1', '--speed-kmh', speed,
+                     '--out', str(bag)]) == 0
+        bags.append(bag)
+    return bags
+
+
+def test_indices_a_quarter_car_cannot_produce_are_n_a(quarter_cars, tmp_path, capsys):
+    """Issue #28 5.7: no lateral dynamics, no roll: null with the reason, not 0 'within'."""
+    out = tmp_path / 'analysis'
+    assert main(['analyze', str(quarter_cars[0]), '--out', str(out)]) == 0
+    metrics = json.loads((out / 'metrics.json').read_text())
+    lateral = 'quarter cars (train.vehicle = sprung_mass) have no lateral dynamics'
+    roll = 'quarter cars (train.vehicle = sprung_mass) have no roll: left and right wheel ' \
+        'loads are equal'
+    for name, reason in (('derailment_coefficient', lateral), ('wheel_load_reduction', roll),
+                         ('lateral_wheelset_force', lateral)):
+        entry = metrics['indices'][name]
+        assert (entry['value'], entry['within_limit'], entry['status'], entry['reason']) == \
+            (None, None, 'n/a', reason)
+    assert metrics['indices']['deck_acceleration']['status'] == 'within'
+    wheel = metrics['wheel_rail']
+    assert wheel['derailment_coefficient_max'] is None
+    assert wheel['lateral_wheelset_force_max_N'] is None
+    assert wheel['wheel_load_reduction_max'] is None
+    assert wheel['not_available']['wheel_load_reduction_max'] == roll
+    assert wheel['wheel_load_reduction_dynamic_max'] > 0   # vertical dynamics: rated
+    page = (out / 'index.html').read_text()
+    assert f'<td>n/a</td><td>n/a</td><td>n/a: {lateral}</td>' in page   # value, verdict, why
+    row = case_row({'case': 'v100', 'speed_kmh': 100.0, 'status': 'ok', 'metrics': metrics})
+    assert row['derailment_coefficient_max'] is None   # an empty cell of sweep.csv, no point
+    assert row['wheel_load_reduction_max'] == wheel['wheel_load_reduction_dynamic_max']
+
+
+def test_without_summary_the_bag_shows_what_it_lacks(quarter_cars, tmp_path):
+    bag = tmp_path / 'bag'
+    shutil.copytree(quarter_cars[0], bag)
+    (bag / 'summary.json').unlink()
+    indices = bag_metrics(load_streams(bag))['indices']
+    assert indices['derailment_coefficient']['reason'] == 'the bag has no lateral wheel-rail force'
+    assert indices['wheel_load_reduction']['reason'] == \
+        'left and right wheel loads are equal in the bag'
+
+
+def test_compare_labels_bags_of_one_folder_name_by_scenario_and_speed(quarter_cars, tmp_path):
+    out = tmp_path / 'cmp'
+    assert main(['compare', *map(str, quarter_cars), '--out', str(out)]) == 0
+    with (out / 'differences.csv').open() as fh:
+        head = next(csv.reader(fh))
+    assert head[:3] == ['metric', 'sprung_mass_beam 100 km/h', 'sprung_mass_beam 120 km/h']
+    assert set(json.loads((out / 'metrics.json').read_text())['bags']) == {
+        'sprung_mass_beam 100 km/h', 'sprung_mass_beam 120 km/h'}
+
+
+def test_default_labels_fall_back_to_parent_folders_then_numbers(quarter_cars, tmp_path):
+    same = [tmp_path / 'x' / 'bag', tmp_path / 'y' / 'bag']
+    for bag in same:
+        shutil.copytree(quarter_cars[0], bag)   # the same scenario and speed
+    assert default_labels(same) == ['x/bag', 'y/bag']
+    assert default_labels([same[0], same[0]]) == ['1:bag', '2:bag']
+    assert default_labels(quarter_cars) == ['sprung_mass_beam 100 km/h',
+                                            'sprung_mass_beam 120 km/h']
+    assert default_labels([same[0], quarter_cars[1].parent]) == ['bag', 'b']
+
+
+HEAVY = ('matplotlib', 'scipy', 'ttb_sim.analysis', 'ttb_sim.sim')
+"""What analyze and compare import only for a bag they can read (seconds at load)."""
+
+
+def test_refusals_come_before_the_heavy_imports(bag, tmp_path):
+    """Issue #28 5.6: a wrong path is refused before scipy, matplotlib or the model load."""
+    broken = tmp_path / 'broken'
+    broken.mkdir()
+    (broken / 'metadata.yaml').write_text('rosbag2_bagfile_information: {relative_file_paths: '
+                                          '[gone.mcap]}\n')
+    cut = tmp_path / 'cut'
+    cut.mkdir()
+    (cut / 'metadata.yaml').write_bytes((bag / 'metadata.yaml').read_bytes())
+    data = next(bag.glob('*.mcap'))
+    (cut / data.name).write_bytes(data.read_bytes()[:1000])
+    (tmp_path / 'file').write_text('x')
+    cases = [['analyze', str(tmp_path / 'missing')], ['analyze', str(broken)],
+             ['analyze', str(cut)], ['analyze', str(bag), '--out', str(tmp_path / 'file')],
+             ['compare', str(bag), str(tmp_path / 'missing')], ['compare', str(bag), str(cut)]]
+    script = ('import json, sys\nfrom ttb_sim.cli import main\n'
+              'code = main(json.loads(sys.argv[1]))\n'
+              f'print(code, [m for m in {HEAVY!r} if m in sys.modules])')
+    for args in cases:
+        result = subprocess.run([sys.executable, '-c', script, json.dumps(args)],
+                                capture_output=True, text=True, timeout=300)
+        assert result.stdout == '2 []\n', (args, result.stdout, result.stderr)
+        assert result.stderr.startswith('ttb-sim: error: ') and result.stderr.count('\n') == 1
 
 
 def test_compare_overlays_and_differences(bag, tmp_path):

@@ -65,10 +65,24 @@ def test_overrides_are_yaml_scalars():
     ('bridge.elements_per_span=15', r'must be even'),
     ('foundation.model=springs', r"needs bearings.model = 'elastic'"),
     ('bridge.span_length', r'expected KEY=VALUE'),
+    ('train=5', r'train = 5: train is a section, not a value; set one of its keys, e\.g\. '
+     r'train\.speed_kmh \(its 11 keys: train\.vehicle, '),
+    ('soil.mesh={h: 1}', r"soil.mesh = \{'h': 1\}: soil.mesh is a section, not a value; set one "
+     r'of its keys, e\.g\. soil\.mesh\.h \(its 6 keys'),
+    ('output=', r"output = '': output is a section, not a value; .* 3 keys: output.rate_hz, "
+     r'output.observers, output.soil_points; see'),
 ])
 def test_refusals_name_key_value_and_range(override, match):
     with pytest.raises(ScenarioError, match=match):
         load_scenario('moving_force_beam', [override])
+
+
+def test_key_spec_names_a_section_and_its_keys():
+    with pytest.raises(ScenarioError, match=r'^car is a section, not a value; set one of its '
+                       r'keys, e\.g\. car\.car_body_mass \(its 37 keys: '):
+        key_spec('car')
+    with pytest.raises(ScenarioError, match=r"^unknown key 'cars'"):
+        key_spec('cars')
 
 
 def test_unknown_key_in_file(tmp_path: Path):

@@ -229,6 +229,68 @@ def test_a_truncated_bag(written, tmp_path: Path, storage):
         read_bag(bag)
 
 
+@pytest.mark.parametrize('storage', ['mcap', 'sqlite3'])
+def test_recovery_is_pointed_to_only_for_a_cut_mcap(written, tmp_path: Path, storage):
+    paths, _ = written
+    bag = tmp_path / 'cut'
+    shutil.copytree(paths[storage], bag)
+    data = next(p for p in bag.iterdir() if p.suffix in ('.mcap', '.db3'))
+    data.write_bytes(data.read_bytes()[:data.stat().st_size // 2])
+    with pytest.raises(BagError) as info:
+        read_bag(bag)
+    message = str(info.value)
+    assert '\n' not in message and f'({str(data)!r}: ' in message
+    assert message.endswith(': `mcap recover` may rescue it') == (storage == 'mcap')
+
+
+@pytest.mark.parametrize('text, message', [
+    ('rosbag2_bagfile_information: [\n', r'is not valid YAML: .*\(line 2, column 1\)$'),
+    ('rosbag2_bagfile_information:\n  version: 9\n\tfiles: []\n',
+     r'is not valid YAML: .*\(line 3, column 1\)$'),
+    ('', r"is not rosbag2 metadata: it needs a mapping 'rosbag2_bagfile_information' at the "
+     r'top, found nothing \(an empty file\)$'),
+    ('foo: 1\nbar: 2\n', r'is not rosbag2 metadata: .* found the keys foo, bar$'),
+    ('- 1\n', r'is not rosbag2 metadata: .* found a list$'),
+    ('rosbag2_bagfile_information: {}\n', r"is invalid: the key 'version' is missing$"),
+    ('rosbag2_bagfile_information: {version: 9, relative_file_paths: [gone.mcap]}\n',
+     r"lists storage files that are not in '.*meta': gone.mcap$"),
+])
+def test_a_broken_metadata_file_is_named_in_one_line(written, tmp_path: Path, text, message):
+    paths, _ = written
+    bag = tmp_path / 'meta'
+    shutil.copytree(paths['mcap'], bag)
+    (bag / 'metadata.yaml').write_text(text)
+    with pytest.raises(BagError, match=rf"^bag metadata '{bag}/metadata.yaml' {message}") as info:
+        read_bag(bag)
+    assert '\n' not in str(info.value) and 'mcap recover' not in str(info.value)
+    (bag / 'metadata.yaml').write_bytes(b'\xff\xfe')
+    with pytest.raises(BagError, match=r'metadata.yaml. cannot be read: not UTF-8 text'):
+        bag_topics(bag)
+
+
+def test_damaged_messages_are_refused_not_raised(written, tmp_path: Path):
+    """Bytes changed inside an MCAP: a length field or a message gone wrong is a BagError."""
+    paths, _ = written
+    source = next(p for p in paths['mcap'].iterdir() if p.suffix == '.mcap')
+    data = source.read_bytes()
+    rng = np.random.default_rng(1)
+    outcomes = set()
+    for trial in range(12):
+        bag = tmp_path / f'damaged{trial}'
+        shutil.copytree(paths['mcap'], bag)
+        damaged = bytearray(data)
+        for i in rng.integers(0, len(data), 20):
+            damaged[i] = int(rng.integers(0, 256))
+        (bag / source.name).write_bytes(bytes(damaged))
+        try:
+            read_bag(bag)
+            outcomes.add('read')
+        except BagError as exc:
+            assert '\n' not in str(exc) and str(exc).startswith(f'bag {str(bag)!r} ')
+            outcomes.add('refused')
+    assert 'refused' in outcomes
+
+
 # -- what `ros2 bag record` adds ------------------------------------------------------------
 
 def _header(store, stamp_ns: int, frame_id: str):

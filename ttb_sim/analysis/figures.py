@@ -26,7 +26,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Sequence
+from typing import Any, Optional, Sequence
 
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
@@ -34,7 +34,8 @@ import numpy as np
 
 from ttb_sim.analysis.excitation import Excitation
 
-__all__ = ['Panel', 'contour_figure', 'indices_figure', 'panels_figure']
+__all__ = ['contour_figure', 'grid_figure', 'in_view', 'index_chart', 'IndexValue',
+           'indices_figure', 'Panel', 'panels_figure']
 
 Trace = tuple[str, np.ndarray, np.ndarray]
 """(label, x, y) of one line."""
@@ -65,9 +66,9 @@ def _save(fig: Figure, path: Path) -> None:
     fig.savefig(str(path), dpi=110)
 
 
-def _mark(ax: Any, marks: Sequence[Excitation], xlim: tuple[float, float] | None) -> list[Any]:
-    """Draw excitation frequencies (dashed) and bands (shaded); return their legend handles."""
-    lo, hi = xlim if xlim else (-np.inf, np.inf)
+def _mark(ax: Any, marks: Sequence[Excitation]) -> list[Any]:
+    """Draw the excitation frequencies in view (dashed), bands (shaded); return their handles."""
+    lo, hi = sorted(ax.get_xlim())
     handles = []
     for i, m in enumerate(marks):
         if m.high < lo or m.low > hi:
@@ -79,10 +80,41 @@ def _mark(ax: Any, marks: Sequence[Excitation], xlim: tuple[float, float] | None
                                       label=label))
         else:
             handles.append(ax.axvline(m.low, color=colour, ls='--', lw=0.9, label=label))
+    ax.set_xlim(lo, hi)   # the marks do not widen the view
     return handles
 
 
-def _draw(ax: Any, panel: Panel, mark_legend: bool = True) -> None:
+def _fit_ylabel(ax: Any, text: str) -> None:
+    """Set a y label, on two lines when one would be longer than the axis (and be clipped)."""
+    label = ax.set_ylabel(text)
+    renderer = ax.figure.canvas.get_renderer()
+    if label.get_window_extent(renderer).height <= ax.get_window_extent(renderer).height:
+        return
+    spaces = [i for i, c in enumerate(text) if c == ' ' and text[:i].count('$') % 2 == 0]
+    if spaces:
+        # nearest the middle, preferring a break before a parenthesis (a unit, a filter)
+        cut = min(spaces, key=lambda i: abs(i - len(text) / 2)
+                  + (0 if text[i + 1:i + 2] == '(' else len(text) / 4))
+        ax.set_ylabel(f'{text[:cut]}\n{text[cut + 1:]}')
+
+
+def in_view(ax: Any, x: np.ndarray, y: np.ndarray) -> bool:
+    """Return True when any part of the line through (x, y) lies inside the axes' limits."""
+    x0, x1 = sorted(ax.get_xlim())
+    y0, y1 = sorted(ax.get_ylim())
+    x, y = np.asarray(x, dtype=float), np.asarray(y, dtype=float)
+    ok = np.isfinite(x) & np.isfinite(y)
+    inside_x = ok & (x >= x0) & (x <= x1)
+    if np.any(inside_x & (y >= y0) & (y <= y1)):
+        return True
+    # a segment crossing the view between two samples outside it (above, then below)
+    a, b = y[:-1], y[1:]
+    both = inside_x[:-1] & inside_x[1:]
+    return bool(np.any(both & (((a > y1) & (b < y0)) | ((a < y0) & (b > y1)))))
+
+
+def _plot(ax: Any, panel: Panel) -> tuple[list[Any], float]:
+    """Draw the traces of a panel; return their lines and the largest finite value."""
     lines = []
     top = -np.inf
     for label, x, y in panel.traces:
@@ -99,6 +131,19 @@ def _draw(ax: Any, panel: Panel, mark_legend: bool = True) -> None:
             lines.extend(ax.plot(xs, ys, '-s', label=label, lw=1.2, ms=4))
         else:
             lines.extend(ax.plot(xs, ys, label=label, lw=0.8))
+    return lines, top
+
+
+def _draw(ax: Any, panel: Panel, explained: set[str]) -> None:
+    """
+    Draw one panel; its legend lists the traces in view and the marks not yet explained.
+
+    A trace that lies wholly outside the limits (under a log axis' floor, below
+    ``floor_below_top``, beyond ``xlim``) is left out of the legend and named in
+    a note instead; an excitation mark is explained in the first panel that
+    shows it (``explained`` collects the labels across the figure).
+    """
+    lines, top = _plot(ax, panel)
     if panel.logx:
         ax.set_xscale('log')
     if panel.logy:
@@ -110,17 +155,41 @@ def _draw(ax: Any, panel: Panel, mark_legend: bool = True) -> None:
     if panel.xlim:
         ax.set_xlim(*panel.xlim)
     ax.set_xlabel(panel.xlabel)
-    ax.set_ylabel(panel.ylabel)
+    _fit_ylabel(ax, panel.ylabel)
     ax.set_title(panel.title, fontsize=9)
     ax.grid(True, which='major', alpha=0.3)
-    handles = _mark(ax, panel.marks, panel.xlim)
-    if not mark_legend:
-        handles = []
-    if len(panel.traces) > 1 or panel.legend:
-        handles = lines + handles
+    marks = [h for h in _mark(ax, panel.marks) if h.get_label() not in explained]
+    explained.update(h.get_label() for h in marks)
+    shown = [ln for ln in lines if in_view(ax, ln.get_xdata(), ln.get_ydata())]
+    hidden = [ln.get_label() for ln in lines if ln not in shown]
+    handles = (shown if len(panel.traces) > 1 or panel.legend else []) + marks
     if handles:
-        ax.legend(handles=handles, fontsize=6.5, framealpha=0.75,
-                  loc='best')
+        ax.legend(handles=handles, fontsize=6.5, framealpha=0.75, loc='best')
+    if hidden:
+        ax.text(0.01, 0.01, f'not in view: {", ".join(hidden)}', transform=ax.transAxes,
+                fontsize=6.5, color='0.35', va='bottom')
+
+
+def grid_figure(title: str, rows: Sequence[Sequence[Panel]]) -> Figure:
+    """Return a figure of a grid of panels (rows of equal length, e.g. time beside PSD)."""
+    n_rows, n_cols = len(rows), max(len(r) for r in rows)
+    width, height = 6.0 * n_cols, 3.4 * n_rows + 0.5
+    fig = Figure(figsize=(width, height))
+    FigureCanvasAgg(fig)   # a renderer, to measure labels
+    fig.suptitle(title, fontsize=11)
+    axes = fig.subplots(n_rows, n_cols, squeeze=False)
+    # a fixed layout in inches (constrained layout costs seconds per figure)
+    fig.subplots_adjust(left=1.05 / width, right=1 - 0.25 / width, bottom=0.55 / height,
+                        top=1 - 0.85 / height, wspace=1.2 / (6.0 - 1.2),
+                        hspace=0.9 / (3.4 - 0.9))
+    explained: set[str] = set()   # each excitation mark is explained once, where first shown
+    for i, row in enumerate(rows):
+        for j in range(n_cols):
+            if j < len(row):
+                _draw(axes[i][j], row[j], explained)
+            else:
+                axes[i][j].set_visible(False)
+    return fig
 
 
 def panels_figure(path: Path, title: str, rows: Sequence[Sequence[Panel]]) -> Path:
@@ -129,24 +198,7 @@ def panels_figure(path: Path, title: str, rows: Sequence[Sequence[Panel]]) -> Pa
 
     Returns the path written.
     """
-    n_rows, n_cols = len(rows), max(len(r) for r in rows)
-    width, height = 6.0 * n_cols, 3.4 * n_rows + 0.5
-    fig = Figure(figsize=(width, height))
-    fig.suptitle(title, fontsize=11)
-    axes = fig.subplots(n_rows, n_cols, squeeze=False)
-    # a fixed layout in inches (constrained layout costs seconds per figure)
-    fig.subplots_adjust(left=1.05 / width, right=1 - 0.25 / width, bottom=0.55 / height,
-                        top=1 - 0.85 / height, wspace=1.2 / (6.0 - 1.2),
-                        hspace=0.9 / (3.4 - 0.9))
-    legend_done = False   # the excitation marks are explained once, in the first panel
-    for i, row in enumerate(rows):
-        for j in range(n_cols):
-            if j < len(row):
-                _draw(axes[i][j], row[j], not legend_done)
-                legend_done = legend_done or bool(row[j].marks)
-            else:
-                axes[i][j].set_visible(False)
-    _save(fig, path)
+    _save(grid_figure(title, rows), path)
     return path
 
 
@@ -168,29 +220,43 @@ def contour_figure(path: Path, title: str, t: np.ndarray, s: np.ndarray, values:
     return path
 
 
-def indices_figure(path: Path, title: str,
-                   rows: Sequence[tuple[str, Sequence[tuple[str, float]], float, str]]) -> Path:
-    """
-    Write ride and safety indices as bars against their limits to a PNG.
+IndexValue = tuple[str, Optional[float], str]
+"""(bag label, value or None where the model cannot produce the index, reason for None)."""
 
-    ``rows`` are (index name, [(bag label, value)], limit, unit); each bar is the
-    value over its limit (1 = at the limit), annotated with the value and unit.
+
+def index_chart(title: str,
+                rows: Sequence[tuple[str, Sequence[IndexValue], float, str]]) -> Figure:
     """
-    fig = Figure(figsize=(9.0, 0.55 * max(len(rows), 1) * max(len(rows[0][1]), 1) + 1.6
-                          if rows else 2.0))
+    Return ride and safety indices as bars against their limits.
+
+    ``rows`` are (index name, [(bag label, value, reason)], limit, unit); each bar
+    is the value over its limit (1 = at the limit), annotated with the value and
+    unit. A value of None (an index the bag's model cannot produce, e.g. the
+    derailment coefficient of a quarter car) has no bar: 'n/a' and the reason.
+    The margins are fixed in inches, so one row has room for its axis label.
+    """
+    n_bars = sum(max(len(values), 1) for _, values, _, _ in rows) + 0.4 * max(len(rows) - 1, 0)
+    height = 0.5 * max(n_bars, 1.0) + 1.25
+    fig = Figure(figsize=(9.0, height))
+    FigureCanvasAgg(fig)
     fig.suptitle(title, fontsize=11)
     ax = fig.subplots()
-    fig.subplots_adjust(left=0.32, right=0.97)
+    fig.subplots_adjust(left=0.32, right=0.97, bottom=0.62 / height, top=1 - 0.45 / height)
     y = 0.0
     ticks, names = [], []
     for name, values, limit, unit in rows:
-        for j, (label, value) in enumerate(values):
-            ratio = value / limit if limit else np.nan
-            colour = 'tab:green' if ratio <= 1.0 else 'tab:red'
-            ax.barh(y, ratio, color=colour, height=0.8, alpha=0.8)
+        for label, value, reason in values:
             shown = '' if unit in ('', '-') else f' {unit}'
-            ax.text(max(ratio, 0) + 0.01, y, f'{value:.3g}{shown} (limit {limit:.3g}{shown})',
-                    va='center', fontsize=7)
+            if value is None:
+                ax.text(0.01, y, f'n/a: {reason}' if reason else 'n/a', va='center',
+                        fontsize=7, color='0.35', style='italic')
+            else:
+                ratio = value / limit if limit else np.nan
+                ax.barh(y, ratio, color='tab:green' if ratio <= 1.0 else 'tab:red',
+                        height=0.8, alpha=0.8)
+                ax.text(max(ratio, 0) + 0.01, y,
+                        f'{value:.3g}{shown} (limit {limit:.3g}{shown})', va='center',
+                        fontsize=7)
             ticks.append(y)
             names.append(f'{name} [{label}]' if len(values) > 1 else name)
             y += 1.0
@@ -198,10 +264,16 @@ def indices_figure(path: Path, title: str,
     ax.axvline(1.0, color='k', ls='--', lw=1.0)
     ax.set_yticks(ticks)
     ax.set_yticklabels(names, fontsize=8)
-    ax.invert_yaxis()
+    ax.set_ylim(y - 0.9, -0.5)   # top to bottom, half a bar of room at both ends
     ax.set_xlabel('value / limit (-); dashed line: the limit')
-    xmax = max([1.3] + [v / lim * 1.35 for _, vals, lim, _ in rows for _, v in vals
-                        if lim and np.isfinite(v)])
+    xmax = max([1.3] + [v / lim * 1.35 for _, vals, lim, _ in rows for _, v, _ in vals
+                        if v is not None and lim and np.isfinite(v)])
     ax.set_xlim(0, xmax)
-    _save(fig, path)
+    return fig
+
+
+def indices_figure(path: Path, title: str,
+                   rows: Sequence[tuple[str, Sequence[IndexValue], float, str]]) -> Path:
+    """Write :func:`index_chart` of the rows to a PNG; return the path written."""
+    _save(index_chart(title, rows), path)
     return path

@@ -19,6 +19,10 @@ The bag is read and every metric computed before the output folder is
 touched; figures are written into a staging folder renamed into place at the
 end (:func:`ttb_sim.report.output.staged_output`), so a failure leaves no
 folder that looks complete.
+
+The paths are checked before the bag reader, the analysis (scipy) and the
+figures (matplotlib) are imported: a wrong path is refused in a fraction of a
+second instead of after seconds of imports.
 """
 
 from __future__ import annotations
@@ -28,9 +32,7 @@ from pathlib import Path
 import sys
 import time
 
-from ttb_sim.io.streams import load_streams
-from ttb_sim.report.figures import write_figures
-from ttb_sim.report.metrics import bag_metrics
+from ttb_sim.io.bag_checks import check_bag_path
 from ttb_sim.report.output import check_output, staged_output, write_index, write_json
 
 log = logging.getLogger(__name__)
@@ -57,10 +59,14 @@ def analyze(bag: str | Path, *, out: str | Path | None = None) -> int:
     """
     start = time.perf_counter()
     path = Path(bag)
+    check_bag_path(path)
     target = Path(out) if out is not None else default_output(path)
     check_output(target)
+    from ttb_sim.io.streams import load_streams   # the bag reader, after the checks
     streams = load_streams(path)
     read = time.perf_counter() - start
+    from ttb_sim.report.figures import write_figures   # scipy and matplotlib: a readable bag
+    from ttb_sim.report.metrics import bag_metrics
     metrics = bag_metrics(streams)
     with staged_output(target) as stage:
         written, skipped = write_figures([streams], stage, [metrics])

@@ -23,7 +23,7 @@ import sysconfig
 from typing import Any, Sequence
 
 from ttb_sim.config.records import Scenario
-from ttb_sim.config.schema import canonical_key, from_mapping, key_spec
+from ttb_sim.config.schema import canonical_key, from_mapping, key_spec, section_problem
 from ttb_sim.errors import ScenarioError
 from ttb_sim.inputs import MAX_SHOWN, read_user_file, shown
 import yaml
@@ -43,12 +43,48 @@ class YamlLoader(yaml.SafeLoader):
     scenario never needs them, and aliases nested a few levels deep (a
     "billion laughs" text of a few hundred bytes) expand to more items than
     memory holds. Collections nested deeper than :data:`MAX_YAML_DEPTH` are
-    refused before the recursive composer can exhaust the stack.
+    refused before the recursive composer can exhaust the stack. A key given
+    twice in one mapping is refused naming the key path and both lines (YAML
+    requires unique keys; PyYAML would keep the last value silently).
     """
 
     def __init__(self, stream: str) -> None:
         super().__init__(stream)
         self._depth = 0
+        self._root: yaml.Node | None = None
+
+    def construct_document(self, node: yaml.Node) -> Any:
+        """Construct the document, remembering its root for key paths in messages."""
+        self._root = node
+        return super().construct_document(node)
+
+    def construct_mapping(self, node: yaml.MappingNode, deep: bool = False) -> dict[Any, Any]:
+        """Construct a mapping, refusing a key given twice (both lines named)."""
+        if isinstance(node, yaml.MappingNode):
+            seen: dict[Any, yaml.Node] = {}
+            for key_node, _ in node.value:
+                if key_node.tag == 'tag:yaml.org,2002:merge':
+                    continue
+                key = self.construct_object(key_node, deep=False)
+                try:
+                    first = seen.setdefault(key, key_node)
+                except TypeError:  # an unhashable key: PyYAML's own message follows
+                    continue
+                if first is not key_node:
+                    raise yaml.constructor.ConstructorError(
+                        None, None, self._duplicate(node, key, first, key_node), None)
+        return super().construct_mapping(node, deep=deep)
+
+    def _duplicate(self, node: yaml.MappingNode, key: Any, first: yaml.Node,
+                   again: yaml.Node) -> str:
+        """Return the message for a key given twice: its path and where both are."""
+        parents = _key_path(self._root, node) if self._root is not None else None
+        path = '.'.join([*(parents or []), str(key)]) if parents is not None else str(key)
+        a, b = first.start_mark, again.start_mark
+        where = (f'line {a.line + 1}, columns {a.column + 1} and {b.column + 1}'
+                 if a.line == b.line else f'lines {a.line + 1} and {b.line + 1}')
+        message = f'key {shown(path)} is given twice, on {where}; give it once'
+        return message
 
     def compose_node(self, parent: Any, index: Any) -> Any:
         """Compose one node, refusing anchors, aliases and deep nesting."""
@@ -69,6 +105,22 @@ class YamlLoader(yaml.SafeLoader):
         finally:
             if collection:
                 self._depth -= 1
+
+
+def _key_path(root: yaml.Node, target: yaml.Node) -> list[str] | None:
+    """Return the keys leading from ``root`` to the node ``target`` (None if not found)."""
+    stack: list[tuple[yaml.Node, list[str]]] = [(root, [])]
+    while stack:
+        node, path = stack.pop()
+        if node is target:
+            return path
+        if isinstance(node, yaml.MappingNode):
+            stack.extend((value, [*path, str(key.value) if isinstance(key, yaml.ScalarNode)
+                                  else '?']) for key, value in node.value)
+        elif isinstance(node, yaml.SequenceNode):
+            stack.extend((item, path[:-1] + [f'{path[-1]}[{i}]'] if path else [f'[{i}]'])
+                         for i, item in enumerate(node.value))
+    return None
 
 
 YamlLoader.yaml_implicit_resolvers = {
@@ -126,13 +178,26 @@ def yaml_problem(exc: yaml.YAMLError) -> str:
     may be arbitrarily long.
     """
     if not isinstance(exc, yaml.MarkedYAMLError):
-        return shown(str(exc))[1:-1] if len(str(exc)) > MAX_SHOWN else str(exc)
+        return _one_line(str(exc))
     parts = [p for p in (exc.context, exc.problem) if p]
-    what = shown('; '.join(parts))[1:-1] if parts else 'invalid YAML'
+    what = _one_line('; '.join(parts)) if parts else 'invalid YAML'
     mark = exc.problem_mark or exc.context_mark
     if mark is None:
         return what
     return f'{what} (in "{mark.name}", line {mark.line + 1}, column {mark.column + 1})'
+
+
+def _one_line(text: str) -> str:
+    """
+    Return a message on one line (control characters escaped), cut to a few hundred characters.
+
+    PyYAML's messages may quote a long piece of the input; ours quote values through
+    :func:`shown` already, so the bound is a few times ``MAX_SHOWN``.
+    """
+    limit = 3 * MAX_SHOWN
+    if len(text) > limit:
+        text = f'{text[:limit // 2]}...{text[-limit // 2:]} ({len(text)} characters)'
+    return repr(text)[1:-1]
 
 
 def config_dirs() -> list[Path]:
@@ -187,12 +252,17 @@ def resolve(source: str | Path) -> Path:
     """
     path = Path(source)
     yaml_name = path.suffix in ('.yaml', '.yml')
-    if path.is_file() or (yaml_name and not path.is_dir()):
+    try:
+        is_file, is_dir, exists = path.is_file(), path.is_dir(), path.exists()
+    except OSError as exc:  # a name too long for the file system, say
+        message = f'scenario file {shown(str(source))} cannot be reached ({exc.strerror})'
+        raise ScenarioError(message) from None
+    if is_file or (yaml_name and not is_dir):
         return path  # read_user_file refuses what is missing or not a regular file
     builtins = builtin_scenarios()
     if not yaml_name and str(source) in builtins:
         return builtins[str(source)]  # a folder named like a built-in does not hide it
-    if path.exists():
+    if exists:
         read_user_file(path, 'scenario file', MAX_SCENARIO_BYTES)  # says what it is instead
     names = ', '.join(sorted(builtins)) or '(none found)'
     raise ScenarioError(f'no scenario {shown(str(source))}: give a YAML path or a built-in '
@@ -229,10 +299,15 @@ def apply_overrides(data: dict[str, Any], overrides: Sequence[tuple[str, Any]]) 
     Raises
     ------
     ScenarioError
-        If a key does not exist in the schema.
+        If a key does not exist in the schema, or names a section (a group of
+        keys such as ``train``) instead of a key.
 
     """
     for key, value in overrides:
+        problem = section_problem(canonical_key(key))
+        if problem is not None:
+            message = f'{key} = {shown(value)}: {problem}'
+            raise ScenarioError(message)
         key_spec(key)  # raises on unknown keys
         key = canonical_key(key)
         node = data
@@ -268,7 +343,8 @@ def load_scenario(source: str | Path, overrides: Sequence[str] = (),
     Raises
     ------
     ScenarioError
-        If the file cannot be read or parsed, or any key is invalid.
+        If the file cannot be read or parsed, is empty (only blank lines or
+        comments), gives a key twice, or any key is invalid.
 
     """
     path = resolve(source)
@@ -280,7 +356,10 @@ def load_scenario(source: str | Path, overrides: Sequence[str] = (),
         raise ScenarioError(f'scenario file {name} is not valid YAML: '
                             f'{yaml_problem(exc)}') from None
     if data is None:
-        data = {}
+        message = (f'scenario file {name} is empty (no keys, only blank lines or comments); '
+                   'give the keys to set, e.g. "train: {speed_kmh: 250}", or run a built-in '
+                   'scenario (ttb-sim scenarios)')
+        raise ScenarioError(message)
     if not isinstance(data, dict):
         raise ScenarioError(f'scenario file {name} must hold a mapping of keys, got '
                             f'{shown(data)}')

@@ -266,6 +266,7 @@ def _check_consistency(s: Scenario) -> None:
     if s.bridge.elements_per_span % 2:
         raise ScenarioError(f'bridge.elements_per_span = {s.bridge.elements_per_span}: must be '
                             'even, so that a node sits at mid-span')
+    _check_girder(s)
     if s.foundation.model in ('springs', 'piled') and s.bearings.model == 'rigid':
         raise ScenarioError(f'foundation.model = {s.foundation.model!r} needs bearings.model = '
                             "'elastic' (rigid bearings model ideal fixed supports)")
@@ -279,6 +280,25 @@ def _check_consistency(s: Scenario) -> None:
     _check_model_size(s)
     _check_track_fit(s)
     _check_observers(s)
+
+
+def _check_girder(s: Scenario) -> None:
+    """Refuse girder values whose beam elements or first bending mode are not finite numbers."""
+    b = s.bridge
+    element = b.span_length / b.elements_per_span
+    values: tuple[float, ...]
+    try:   # (a span of 1e-300 m is within the declared range; its element**3 is 0)
+        values = (12.0 * b.bending_stiffness / element**3, b.mass_per_length * element,
+                  span_frequency(b.span_length, b.bending_stiffness, b.mass_per_length))
+    except (ZeroDivisionError, OverflowError):
+        values = (math.inf,)
+    if not all(math.isfinite(v) and v > 0.0 for v in values):
+        message = (f'bridge.span_length = {b.span_length:g} m over bridge.elements_per_span = '
+                   f'{b.elements_per_span} gives beam elements of {element:g} m, whose stiffness '
+                   f'with bridge.bending_stiffness = {b.bending_stiffness:g} N*m^2 and '
+                   f'bridge.mass_per_length = {b.mass_per_length:g} kg/m is not a finite '
+                   'number: give a span of a bridge (metres)')
+        raise ScenarioError(message)
 
 
 def _check_piled(s: Scenario) -> None:

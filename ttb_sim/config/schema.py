@@ -34,7 +34,7 @@ from ttb_sim.errors import ModelError, ScenarioError
 from ttb_sim.inputs import shown
 
 __all__ = ['ALIASES', 'canonical_key', 'from_mapping', 'iter_keys', 'key_spec',
-           'resolve_aliases', 'to_plain']
+           'resolve_aliases', 'section_problem', 'to_plain']
 
 ALIASES = {
     'train.bogie_semi_spacing': 'car.bogie_semi_spacing',
@@ -43,6 +43,9 @@ ALIASES = {
 """Old key paths that still work, and the key each now sets (the car record owns the
 car geometry since the records were unified; scenario files and ``--set`` using the old
 paths keep working)."""
+
+MAX_SECTION_KEYS_SHOWN = 4
+"""Most keys of a section named when a section is given where a key is expected."""
 
 MAX_LIST_ITEMS = 1000
 """Most entries of a list-valued key (axle offsets, observers)."""
@@ -115,8 +118,37 @@ def key_spec(path: str) -> tuple[type, Any, Spec]:
     for key, typ, default, spec in iter_keys():
         if key == path:
             return typ, default, spec
+    problem = section_problem(path)
+    if problem is not None:
+        raise ScenarioError(problem)
     raise ScenarioError(f'unknown key {shown(path)}; see `ttb-sim scenarios --keys` for the '
                         'list')
+
+
+def section_problem(path: str) -> str | None:
+    """
+    Say that ``path`` is a section (a group of keys), not a key, and name its keys.
+
+    Parameters
+    ----------
+    path : str
+        A dotted path, e.g. ``'train'`` or ``'soil.mesh'``.
+
+    Returns
+    -------
+    str or None
+        The message, or None when ``path`` is not a section of the schema.
+
+    """
+    keys = [(key, spec) for key, _, _, spec in iter_keys() if key.startswith(f'{path}.')]
+    if not keys:
+        return None
+    example = next((key for key, spec in keys if spec.dynamic), keys[0][0])
+    names = ', '.join(key for key, _ in keys[:MAX_SECTION_KEYS_SHOWN])
+    more = ', ...' if len(keys) > MAX_SECTION_KEYS_SHOWN else ''
+    message = (f'{path} is a section, not a value; set one of its keys, e.g. {example} '
+               f'(its {len(keys)} keys: {names}{more}; see `ttb-sim scenarios --keys`)')
+    return message
 
 
 def _root(cls: type | None) -> type:

@@ -19,16 +19,49 @@ Input and output: the topic table, the rosbag2 recorder, the bag reader and the 
 bags), ``bag`` records frames to rosbag2 (MCAP or SQLite 3) a block of frames at a
 time, with the CDR layouts ``codec`` learns from the table's builders and the
 block storages of ``block_storage`` under rosbags' writer; ``reader`` reads any
-bag of ours back into numpy arrays per topic, ``streams`` sorts those arrays into
-named, evenly sampled streams (car bodies, wheel-rail forces, girders, piles, soil)
-for the reports.
+bag of ours back into numpy arrays per topic (``bag_checks`` says in one line what
+is wrong with a bag it cannot read), ``streams`` sorts those arrays into named,
+evenly sampled streams (car bodies, wheel-rail forces, girders, piles, soil) for
+the reports.
+
+The names below are imported when first used (PEP 562): ``topics`` and ``bag``
+need the stepping core (``ttb_sim.sim``, over a second to import), which a
+verb that only reads bags, or refuses its arguments, should not wait for.
 """
 
-from ttb_sim.io.bag import BagRecorder, default_bag_path, STORAGES
-from ttb_sim.io.reader import bag_topics, read_bag, TopicArrays
-from ttb_sim.io.streams import load_streams, Series, Streams
-from ttb_sim.io.topics import FRAME_ID, NAMESPACE, PeakTracker, Topic, topic_table
+from __future__ import annotations
+
+import importlib
+from typing import Any, TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from ttb_sim.io.bag import BagRecorder, default_bag_path, STORAGES
+    from ttb_sim.io.reader import bag_topics, read_bag, TopicArrays
+    from ttb_sim.io.streams import load_streams, Series, Streams
+    from ttb_sim.io.topics import FRAME_ID, NAMESPACE, PeakTracker, Topic, topic_table
+
+_FACE = {
+    'ttb_sim.io.bag': ('BagRecorder', 'default_bag_path', 'STORAGES'),
+    'ttb_sim.io.reader': ('bag_topics', 'read_bag', 'TopicArrays'),
+    'ttb_sim.io.streams': ('load_streams', 'Series', 'Streams'),
+    'ttb_sim.io.topics': ('FRAME_ID', 'NAMESPACE', 'PeakTracker', 'Topic', 'topic_table'),
+}
+_HOME = {name: module for module, names in _FACE.items() for name in names}
 
 __all__ = ['bag_topics', 'BagRecorder', 'default_bag_path', 'FRAME_ID', 'load_streams',
            'NAMESPACE', 'PeakTracker', 'read_bag', 'Series', 'STORAGES', 'Streams', 'Topic',
            'topic_table', 'TopicArrays']
+
+
+def __getattr__(name: str) -> Any:
+    """Import a name of the package face from its module on first use."""
+    if name not in _HOME:
+        raise AttributeError(f'module {__name__!r} has no attribute {name!r}')
+    value = getattr(importlib.import_module(_HOME[name]), name)
+    globals()[name] = value
+    return value
+
+
+def __dir__() -> list[str]:
+    """List the module's names with the face's lazily imported ones."""
+    return sorted(set(globals()) | set(__all__))

@@ -65,11 +65,14 @@ from contextlib import contextmanager
 from dataclasses import dataclass
 import logging
 from pathlib import Path
+import struct
 from typing import Any, Iterable, Iterator, Mapping, Sequence
 
 import numpy as np
 from rosbags.rosbag2 import Reader, ReaderError
+from rosbags.serde import SerdeError
 from ttb_sim.errors import BagError
+from ttb_sim.io.bag_checks import check_bag_path, one_line, unreadable
 from ttb_sim.io.cdr import Group, groups, typestore
 
 log = logging.getLogger(__name__)
@@ -238,13 +241,18 @@ def read_bag(path: str | Path, topics: Iterable[str] | None = None) -> dict[str,
                                           if connections else ()):
                 raw[conn.topic].append(data)
                 received[conn.topic].append(timestamp)
-        except ReaderError as exc:
-            raise BagError(_unreadable(path, exc)) from None
+        except CORRUPT as exc:   # a record cut short, or a length field gone wrong
+            raise BagError(unreadable(path, exc)) from None
     store = typestore()
     out: dict[str, TopicArrays] = {}
     for topic in wanted:
         msgtype = available[topic]
-        stamp_ns, fields, components = _decode(store, msgtype, raw[topic])
+        try:
+            stamp_ns, fields, components = _decode(store, msgtype, raw[topic])
+        except (SerdeError, *CORRUPT, ValueError) as exc:
+            msg = f'bag {str(path)!r} is corrupt: the messages of {topic} ({msgtype}) cannot ' \
+                  f'be decoded ({type(exc).__name__}: {one_line(str(exc))})'
+            raise BagError(msg) from None
         out[topic] = TopicArrays(topic, msgtype, stamp_ns,
                                  np.asarray(received[topic], dtype=np.int64), fields,
                                  components)
@@ -252,41 +260,29 @@ def read_bag(path: str | Path, topics: Iterable[str] | None = None) -> dict[str,
     return out
 
 
+CORRUPT = (ReaderError, OverflowError, EOFError, IndexError, struct.error, MemoryError,
+           UnicodeDecodeError)
+"""What reading a damaged storage file raises (rosbags checks most, not every length field)."""
+
+
 # -- opening and selecting --------------------------------------------------------------
 
 @contextmanager
 def _open(path: Path) -> Iterator[Reader]:
-    """Open a bag with rosbags, translating its errors to :class:`BagError`."""
-    if not path.exists():
-        raise BagError(f'bag {str(path)!r} does not exist')
-    if path.is_file() and path.suffix not in ('.mcap', '.db3'):
-        raise BagError(f'{str(path)!r} is not a bag: give its directory (with metadata.yaml) '
-                       'or its .mcap / .db3 file')
-    if path.is_dir() and not (path / 'metadata.yaml').is_file():
-        storage = sorted(p.name for p in path.iterdir() if p.suffix in ('.mcap', '.db3'))
-        if storage:
-            msg = f'{str(path)!r} has {", ".join(storage)} but no metadata.yaml: the ' \
-                  'recording did not finish (a killed run?); `ros2 bag reindex` or ' \
-                  '`mcap recover` may rescue it'
-        else:
-            msg = f'{str(path)!r} is not a rosbag2 directory (no metadata.yaml)'
-        raise BagError(msg)
+    """Open a bag with rosbags, translating its errors to one-line :class:`BagError`."""
+    check_bag_path(path)
     try:
         reader = Reader(path)
         reader.open()
-    except ReaderError as exc:
-        raise BagError(_unreadable(path, exc)) from None
+    except CORRUPT as exc:
+        raise BagError(unreadable(path, exc)) from None
     except (OSError, ValueError, KeyError) as exc:
-        raise BagError(f'bag {str(path)!r} cannot be read: {exc}') from None
+        msg = f'bag {str(path)!r} cannot be read: {one_line(str(exc))}'
+        raise BagError(msg) from None
     try:
         yield reader
     finally:
         reader.close()
-
-
-def _unreadable(path: Path, exc: Exception) -> str:
-    return f'bag {str(path)!r} is truncated or corrupt ({exc}); a recording that was ' \
-           'killed leaves such a file: `mcap recover` (MCAP) may rescue it'
 
 
 def _select(path: Path, available: Mapping[str, str],

@@ -30,7 +30,8 @@ from typing import Callable, Sequence
 import numpy as np
 
 from ttb_sim.analysis.excitation import Excitation
-from ttb_sim.analysis.figures import contour_figure, indices_figure, Panel, panels_figure
+from ttb_sim.analysis.figures import (contour_figure, IndexValue, indices_figure, Panel,
+                                      panels_figure)
 from ttb_sim.analysis.levels import vibration_levels
 from ttb_sim.analysis.psd import resolving_segment_seconds, welch_psd
 from ttb_sim.analysis.rigid_displacement import rigid_midspan_displacement
@@ -350,18 +351,21 @@ def indices(bags: Sequence[Streams], out: Path,
         raise Skip('no car-body, wheel-rail or mid-span topic to rate')
     rows = []
     for name in names:
-        values, limit, unit = [], 0.0, ''
+        values: list[IndexValue] = []
+        limit, unit = 0.0, ''
         for s, m in zip(bags, all_metrics):
             entry = m.get('indices', {}).get(name)
             if entry:
-                values.append((s.label, entry['value']))
+                values.append((s.label, entry['value'], entry.get('reason', '')))
                 limit, unit = entry['limit'], entry['unit']
         rows.append((name.replace('_', ' '), values, limit, unit))
     path = indices_figure(out / 'indices.png', 'Ride comfort and running safety against '
                           'limits', rows)
     return FigureNote(path.name, 'Each index over its limit (Sperling 2.5 = excellent; car '
                       'body 1.3 / 1.0 m/s^2; Q/P 0.8; wheel-load reduction 0.6; lateral '
-                      'wheelset force 10 kN + P0/3; deck 5 m/s^2): green within, red beyond.')
+                      'wheelset force 10 kN + P0/3; deck 5 m/s^2): green within, red beyond; '
+                      "n/a where the bag's vehicle model cannot produce the index (a quarter "
+                      'car has no lateral dynamics), with the reason.')
 
 
 FIGURES: tuple[Callable[..., FigureNote | list[FigureNote]], ...] = (

@@ -51,6 +51,8 @@ SPERLING_LIMIT = 2.5
 """Sperling index below which a passenger car rates 'excellent'."""
 _OBSERVER = re.compile(r'^\s*([^=\s]+)\s*=\s*(\w+)\s*@\s*([-+0-9.eE]+)\s*$')
 _LAYERS = ('rail', 'slab', 'base', 'girder')
+_VEHICLES = {'sprung_mass': 'quarter cars', 'moving_force': 'moving forces'}
+"""The vehicle models without lateral dynamics, as the reason of an index they lack names them."""
 
 
 # -- excitation marks ---------------------------------------------------------------------
@@ -82,8 +84,48 @@ def marks_of(s: Streams) -> list[Excitation]:
 # -- metrics -----------------------------------------------------------------------------
 
 def _index(value: float, limit: float, unit: str, where: str) -> dict[str, Any]:
+    within = bool(value <= limit)
     return {'value': float(value), 'limit': float(limit), 'unit': unit, 'where': where,
-            'within_limit': bool(value <= limit)}
+            'within_limit': within, 'status': 'within' if within else 'exceeded'}
+
+
+def _not_available(limit: float, unit: str, reason: str) -> dict[str, Any]:
+    """Return an index the bag's model cannot produce: no value, no verdict, the reason."""
+    return {'value': None, 'limit': float(limit), 'unit': unit, 'where': '',
+            'within_limit': None, 'status': 'n/a', 'reason': reason}
+
+
+def unavailable_indices(s: Streams) -> dict[str, str]:
+    """
+    Return the wheel-rail indices the bag's vehicle model cannot produce, with the reason.
+
+    Quarter cars and moving forces (``train.vehicle`` in the scenario echo) have
+    no lateral dynamics, so no derailment coefficient or lateral wheelset force,
+    and no roll, so no left-right wheel-load reduction (GB 5599 form); only the
+    42-DOF car has both.  Without the echo the bag itself decides: no lateral
+    force anywhere, or left and right wheel loads equal throughout.
+    """
+    vehicle = s.section('train').get('vehicle')
+    if vehicle == 'car':
+        return {}
+    if vehicle is not None:
+        model = f'{_VEHICLES.get(str(vehicle), "the vehicle model")} (train.vehicle = {vehicle})'
+        lateral: str | None = f'{model} have no lateral dynamics'
+        roll: str | None = f'{model} have no roll: left and right wheel loads are equal'
+    else:
+        pairs = [(v, s.wheel_rail[(car, axle, 'right')]) for (car, axle, side), v
+                 in s.wheel_rail.items()
+                 if side == 'left' and (car, axle, 'right') in s.wheel_rail]
+        lateral = None if any(np.any(v.values[:, 1]) for v in s.wheel_rail.values()) else \
+            'the bag has no lateral wheel-rail force'
+        roll = 'left and right wheel loads are equal in the bag' if pairs and all(
+            np.array_equal(a.values[:, 2], b.values[:, 2]) for a, b in pairs) else None
+    out = {}
+    if lateral is not None:
+        out['derailment_coefficient'] = out['lateral_wheelset_force'] = lateral
+    if roll is not None:
+        out['wheel_load_reduction'] = roll
+    return out
 
 
 def _psd(series: Series, column: int, lowest_hz: float) -> tuple[np.ndarray, np.ndarray]:
@@ -203,14 +245,22 @@ def _wheel_rail_metrics(s: Streams) -> tuple[dict[str, Any], dict[str, Any]]:
                                'wheel_load_reduction_max': gb_max,
                                'wheel_load_reduction_dynamic_max': dyn_max,
                                'lateral_wheelset_force_max_N': h_max}
-    indices = {'derailment_coefficient': _index(qp_max, LIMITS['derailment_coefficient'], '-',
-                                                qp_where),
-               'wheel_load_reduction': _index(gb_max, LIMITS['wheel_load_reduction'], '-',
-                                              red_where)}
+    found = {'derailment_coefficient': (qp_max, LIMITS['derailment_coefficient'], '-', qp_where),
+             'wheel_load_reduction': (gb_max, LIMITS['wheel_load_reduction'], '-', red_where)}
     if axle_loads:
         limit = lateral_force_limit(float(np.mean(axle_loads)))
         metrics['lateral_wheelset_force_limit_N'] = limit
-        indices['lateral_wheelset_force'] = _index(h_max / 1e3, limit / 1e3, 'kN', h_where)
+        found['lateral_wheelset_force'] = (h_max / 1e3, limit / 1e3, 'kN', h_where)
+    missing = unavailable_indices(s)
+    indices = {name: _not_available(limit, unit, missing[name]) if name in missing
+               else _index(value, limit, unit, where)
+               for name, (value, limit, unit, where) in found.items()}
+    if missing:   # null, not 0, for what the model cannot produce
+        columns = {'derailment_coefficient': 'derailment_coefficient_max',
+                   'wheel_load_reduction': 'wheel_load_reduction_max',
+                   'lateral_wheelset_force': 'lateral_wheelset_force_max_N'}
+        metrics['not_available'] = {columns[name]: reason for name, reason in missing.items()}
+        metrics.update(dict.fromkeys(metrics['not_available']))
     first = s.wheel_rail[min(s.wheel_rail)]
     junction = next((m.low for m in marks_of(s) if m.label.startswith('V/')), None)
     if junction and first.rate > 4.0 * junction and first.t.size / first.rate >= 2.0:

@@ -48,6 +48,13 @@ class FigureNote:
 
 def check_output(out: Path) -> None:
     """Refuse an output folder that cannot be (re)written, before any work is done."""
+    try:
+        out.stat()
+    except FileNotFoundError:
+        pass
+    except (OSError, ValueError) as exc:   # a name too long, a NUL byte, a loop of links
+        reason = exc.strerror if isinstance(exc, OSError) and exc.strerror else str(exc)
+        raise ScenarioError(f'--out {str(out)!r} cannot be used ({reason})') from None
     if out.exists() and not out.is_dir():
         raise ScenarioError(f'--out {str(out)!r} is a file; give a folder to write the '
                             'figures, metrics.json and index.html into')
@@ -113,7 +120,12 @@ def _table(head: Sequence[str], rows: Sequence[Sequence[Any]]) -> str:
 
 
 def index_rows(labels: Sequence[str], metrics: Sequence[dict[str, Any]]) -> list[list[Any]]:
-    """Return rows (index, unit, limit, value per bag, where) of the ride and safety indices."""
+    """
+    Return rows (index, unit, limit, value per bag, verdict, where) of the ride and safety indices.
+
+    An index a bag's model cannot produce (value null) shows as 'n/a' with its reason; the
+    verdict rates the bags that have a value ('n/a' when none has).
+    """
     names: list[str] = []
     for m in metrics:
         names.extend(k for k in m.get('indices', {}) if k not in names)
@@ -121,11 +133,15 @@ def index_rows(labels: Sequence[str], metrics: Sequence[dict[str, Any]]) -> list
     for name in names:
         entries = [m.get('indices', {}).get(name) for m in metrics]
         first = next(e for e in entries if e)
-        values = [e['value'] if e else None for e in entries]
-        ok = all(e['within_limit'] for e in entries if e)
-        rows.append([name.replace('_', ' '), first['unit'], first['limit'], *values,
-                     'within' if ok else 'EXCEEDED',
-                     '; '.join(e['where'] for e in entries if e and e['where'])])
+        rated = [e for e in entries if e and e.get('value') is not None]
+        values = [None if not e else 'n/a' if e.get('value') is None else e['value']
+                  for e in entries]
+        verdict = 'n/a' if not rated else (
+            'within' if all(e['within_limit'] for e in rated) else 'EXCEEDED')
+        where = [e['where'] or (f'n/a: {e["reason"]}' if e.get('value') is None
+                                and e.get('reason') else '') for e in entries if e]
+        rows.append([name.replace('_', ' '), first['unit'], first['limit'], *values, verdict,
+                     '; '.join(w for w in where if w)])
     return rows
 
 

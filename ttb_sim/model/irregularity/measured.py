@@ -143,14 +143,16 @@ def load_csv(
         the wrong number of fields or a non-numeric / non-finite value, x does
         not strictly increase, there are fewer than ``MIN_CSV_ROWS`` rows, or
         the profile is shorter than ``min_length``.  The message names the
-        file and the row.
+        file and the row.  Cells are checked before rows are counted, so a
+        short file with a bad cell names the cell (row, column and text).
     ModelError
         If ``dx`` is given and is not a finite number > 0.
 
     """
     rows, content = _read_rows(path)
     header, data_index = _header(path, rows, content)
-    numbers, row_numbers = _numbers(path, rows, header, data_index)
+    numbers, row_numbers = _numbers(path, rows, header, data_index)  # bad cells first
+    _check_count(path, data_index, int(content[0]))
     x = numbers[:, 0]
     rails = numbers[:, 1:].T
     steps, covered = _check_x(path, x, row_numbers, min_length)
@@ -202,6 +204,11 @@ def _header(path: str | PathLike[str], rows: list[list[str]],
             raise _refuse(path, header_index + 1,
                           f'duplicated column(s) {", ".join(duplicated)}')
         data_index = content[1:]
+    return header, data_index
+
+
+def _check_count(path: str | PathLike[str], data_index: np.ndarray, header_index: int) -> None:
+    """Refuse fewer than MIN_CSV_ROWS data rows (after their cells were checked)."""
     if data_index.size < MIN_CSV_ROWS:
         row_numbers = data_index + 1
         last = f'last data row {row_numbers[-1]}' if data_index.size else 'no data rows'
@@ -210,7 +217,6 @@ def _header(path: str | PathLike[str], rows: list[list[str]],
             f'{MIN_CSV_ROWS}')
         raise _refuse(path, int(row_numbers[-1]) if data_index.size else header_index + 1,
                       message)
-    return header, data_index
 
 
 def _numbers(path: str | PathLike[str], rows: list[list[str]], header: list[str],
@@ -224,14 +230,14 @@ def _numbers(path: str | PathLike[str], rows: list[list[str]], header: list[str]
         message = f'expected {len(header)} fields as in the header, found {widths[r]}'
         raise _refuse(path, int(row_numbers[r]), message)
     columns = [header.index(name) for name in CSV_COLUMNS]
-    data_rows = operator.itemgetter(*data_index)(rows)
-    selected = [[row[j].strip() for j in columns] for row in data_rows]
+    getter = operator.itemgetter(*columns)
+    selected = [[cell.strip() for cell in getter(rows[i])] for i in data_index]
     for r, row_cells in enumerate(selected):  # bound the fixed-width array below
         for c, cell in enumerate(row_cells):
             if len(cell) > MAX_CELL_CHARS:
                 message = f'non-numeric value {shown(cell)} in column {CSV_COLUMNS[c]}'
                 raise _refuse(path, int(row_numbers[r]), message)
-    cells = np.array(selected, dtype=str)
+    cells = np.array(selected, dtype=str).reshape(len(selected), len(CSV_COLUMNS))
     try:
         numbers = cells.astype(np.float64)
     except ValueError:
