@@ -122,7 +122,7 @@ class IrregularityConfig:
 class SolverConfig:
     """Time integration (Newmark average acceleration)."""
 
-    dt: float = param(0.0, 's', 'Time step; 0 picks it automatically (see README).', low=0.0,
+    dt: float = param(0.0, 's', 'Time step; 0 picks it automatically (docs/model.md).', low=0.0,
                       high=0.1)
     duration: float = param(0.0, 's', 'Simulated time; 0 runs until the last axle has left '
                             'the bridge plus free_vibration_periods fundamental periods.',
@@ -138,7 +138,7 @@ class SolverConfig:
                          'symmetric effective matrices with a fill-reducing order and take the '
                          "lean step: 'qdldl' (LDL^T, the fastest measured), 'cholmod' "
                          "(CHOLMOD Cholesky via cholespy), 'superlu_sym' (pure scipy). They "
-                         "agree with 'reference' to round-off (README, Benchmark). 'reduced' "
+                         "agree with 'reference' to round-off (docs/performance.md). 'reduced' "
                          '(opt-in) is qdldl with the slab track detailed only in a window '
                          'around the train, the far track condensed onto the bridge.',
                          choices=('qdldl', 'cholmod', 'superlu_sym', 'reference', 'reduced'))
@@ -158,8 +158,8 @@ class SolverConfig:
                          'results are the same bits with any count.', low=0, high=64)
     window_margin: float = param(30.0, 'm', "solver.variant 'reduced': detailed track kept "
                                  'behind the last axle and ahead of the first; more keeps '
-                                 "more of the track's waves at more cost (README, "
-                                 'Benchmark).', low=5.0, high=10000.0)
+                                 "more of the track's waves at more cost "
+                                 '(docs/performance.md).', low=5.0, high=10000.0)
 
 
 @dataclass(frozen=True)

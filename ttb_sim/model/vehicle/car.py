@@ -87,14 +87,14 @@ class CarParameters:
                                        'damper.', low=0.0, high=1e9)
     primary_vertical_dampers: int = param(4, '-', 'Primary vertical dampers per car (one per '
                                           'wheelset: Zhai-type bogies carry one damper per '
-                                          'side of each bogie; see README).', low=0, high=64)
+                                          'side of each bogie; docs/model.md).', low=0, high=64)
     secondary_vertical_dampers: int = param(2, '-', 'Secondary vertical dampers per car (one '
                                             'per bogie).', low=0, high=64)
     secondary_lateral_dampers: int = param(2, '-', 'Secondary lateral dampers per car (one '
                                            'per bogie).', low=0, high=64)
     yaw_damping: float = param(250.0e3, 'N*s/m', 'Anti-yaw (longitudinal) damper between '
                                'bogie and car body, per damper; assumed, not in [P] Table 1 '
-                               '(see README).', low=0.0, high=1e9)
+                               '(see docs/model.md).', low=0.0, high=1e9)
     yaw_dampers: int = param(4, '-', 'Anti-yaw dampers per car (one on each side of each bogie; '
                              '0 = the literal Table 1 car).', low=0, high=64)
     yaw_damper_semi_spacing: float = param(1.35, 'm', 'Lateral semi-spacing of the anti-yaw '
