@@ -175,7 +175,7 @@ def bench(scenarios: Sequence[str] = (), variants: Sequence[str] = (),
         best: dict[str, tuple[dict[str, Any], Traces]] = {}
         for _round in range(repeat):
             for name in plan.variants:
-                if name == REFERENCE and plan.refusal is not None:
+                if name in plan.refusals:
                     continue
                 if progress is not None:
                     progress(f'{plan.scenario} / {name}')
@@ -186,7 +186,7 @@ def bench(scenarios: Sequence[str] = (), variants: Sequence[str] = (),
         reference = best[REFERENCE][1] if REFERENCE in best else {}
         for name in plan.variants:
             if name not in best:
-                runs.append(_refused(plan.name, name, plan.refusal or ''))
+                runs.append(_refused(plan.name, name, plan.refusals.get(name, '')))
                 continue
             metrics, traces = best[name]
             metrics['difference'] = compare(traces, reference)
@@ -203,8 +203,9 @@ class _Plan:
     variants: list[str]
     duration: float | None
     overrides: list[str]
-    refusal: str | None
-    """Why ``reference`` is refused for this workload (None: it runs)."""
+    refusals: dict[str, str]
+    """Why a variant is refused for this workload, by variant (``reference`` for the
+    model's size, another where it does not apply to the model)."""
 
 
 def _plan(scenario: str, variants: Sequence[str], duration: float | None,
@@ -221,7 +222,16 @@ def _plan(scenario: str, variants: Sequence[str], duration: float | None,
     if span is not None:
         values.append(('solver.duration', span))
     loaded = load_scenario(scenario, sets, values)
-    return _Plan(scenario, loaded.name, names, span, sets, reference_refusal(loaded))
+    refusals: dict[str, str] = {}
+    refusal = reference_refusal(loaded)
+    if refusal is not None:
+        refusals[REFERENCE] = refusal
+    for name in names[1:]:
+        try:
+            load_scenario(scenario, sets, [('solver.variant', name), *values[1:]])
+        except ScenarioError as exc:
+            refusals[name] = str(exc)
+    return _Plan(scenario, loaded.name, names, span, sets, refusals)
 
 
 def _refused(name: str, variant: str, message: str) -> dict[str, Any]:
