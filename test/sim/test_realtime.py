@@ -13,7 +13,7 @@
 # limitations under the License.
 
 """
-solver.variant 'realtime': the steps between frames in one compiled loop, against the step-by-step path.
+solver.variant 'realtime': the steps between frames in one compiled loop, against qdldl.
 
 For moving forces and quarter cars the loop (``advance`` of the couplings) takes
 the lean Newmark step of ``qdldl`` with the same arithmetic: the moving load or
@@ -31,8 +31,7 @@ import pytest
 
 from ttb_sim.config import load_scenario
 from ttb_sim.errors import DivergenceError, ScenarioError
-from ttb_sim.sim import Simulation
-from ttb_sim.sim import kernel_registry
+from ttb_sim.sim import kernel_registry, Simulation
 
 FIELDS = ('midspan', 'bearings', 'body_acceleration', 'wheel_rail', 'observers', 'speed',
           'head_position')
