@@ -37,11 +37,12 @@ from ttb_sim.config import load_scenario
 from ttb_sim.errors import SimulationError
 
 if TYPE_CHECKING:
-    # The model, the stepping core and the bag writer are imported where first needed
-    # (about a second): a scenario path that does not exist is refused before them.
     from ttb_sim.config import Scenario
     from ttb_sim.io.topics import PeakTracker, Topic
     from ttb_sim.sim import CostEstimate, Runner
+
+# The model, the stepping core and the bag writer are imported where first needed (about a
+# second): a scenario path that does not exist is refused before them.
 
 log = logging.getLogger(__name__)
 
