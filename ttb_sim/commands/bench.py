@@ -249,7 +249,7 @@ def _bench_plan(plan: _Plan, counts: Sequence[int | None], repeat: int, run: _Me
             sets = plan.overrides if count is None else [*plan.overrides,
                                                          f'solver.threads={count}']
             for name in plan.variants:
-                if name == REFERENCE and plan.refusal is not None:
+                if name in plan.refusals:
                     continue
                 if progress is not None:
                     at = '' if count is None else f' / threads {count}'
@@ -265,7 +265,7 @@ def _bench_plan(plan: _Plan, counts: Sequence[int | None], repeat: int, run: _Me
         reference = base[1] if base is not None else {}
         for name in plan.variants:
             if (name, count) not in best:
-                rows.append(_refused(plan.name, name, plan.refusal or '', count))
+                rows.append(_refused(plan.name, name, plan.refusals.get(name, ''), count))
                 continue
             metrics, traces = best[(name, count)]
             metrics['difference'] = compare(traces, reference)
@@ -282,8 +282,9 @@ class _Plan:
     variants: list[str]
     duration: float | None
     overrides: list[str]
-    refusal: str | None
-    """Why ``reference`` is refused for this workload (None: it runs)."""
+    refusals: dict[str, str]
+    """Why a variant is refused for this workload, by variant (``reference`` for the
+    model's size, another where it does not apply to the model)."""
 
 
 def _plan(scenario: str, variants: Sequence[str], duration: float | None,
@@ -300,7 +301,16 @@ def _plan(scenario: str, variants: Sequence[str], duration: float | None,
     if span is not None:
         values.append(('solver.duration', span))
     loaded = load_scenario(scenario, sets, values)
-    return _Plan(scenario, loaded.name, names, span, sets, reference_refusal(loaded))
+    refusals: dict[str, str] = {}
+    refusal = reference_refusal(loaded)
+    if refusal is not None:
+        refusals[REFERENCE] = refusal
+    for name in names[1:]:
+        try:
+            load_scenario(scenario, sets, [('solver.variant', name), *values[1:]])
+        except ScenarioError as exc:
+            refusals[name] = str(exc)
+    return _Plan(scenario, loaded.name, names, span, sets, refusals)
 
 
 def _refused(name: str, variant: str, message: str, threads: int | None) -> dict[str, Any]:

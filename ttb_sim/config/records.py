@@ -140,8 +140,11 @@ class SolverConfig:
                          "(CHOLMOD Cholesky via cholespy), 'superlu_sym' (pure scipy). They "
                          "agree with 'reference' to round-off (docs/performance.md). 'reduced' "
                          '(opt-in) is qdldl with the slab track detailed only in a window '
-                         'around the train, the far track condensed onto the bridge.',
-                         choices=('qdldl', 'cholmod', 'superlu_sym', 'reference', 'reduced'))
+                         "around the train, the far track condensed onto the bridge. 'realtime' "
+                         'is qdldl with the steps between frames in one compiled loop, one '
+                         'thread (moving forces and quarter cars; docs/performance.md).',
+                         choices=('qdldl', 'cholmod', 'superlu_sym', 'reference', 'reduced',
+                                  'realtime'))
     substructure_steps: int = param(3, '-', 'Piled foundations: solver steps per substructure '
                                     'step n ([P] Eqs. 13-14: the substructures advance at '
                                     'n dt, the pier tops interpolated in between); 1 = every '
@@ -277,6 +280,11 @@ def _check_consistency(s: Scenario) -> None:
     if s.track.model == 'slab' and s.train.vehicle != 'car':
         raise ScenarioError(f"track.model = 'slab' needs train.vehicle = 'car' (got "
                             f'{s.train.vehicle!r})')
+    if s.solver.variant == 'realtime' and s.train.vehicle == 'car':
+        raise ScenarioError("solver.variant = 'realtime' does not apply to train.vehicle = "
+                            "'car' yet (multibody cars on the slab track, issue #27); allowed "
+                            "for them: 'reduced' (the fastest), 'qdldl', 'cholmod', "
+                            "'superlu_sym', 'reference'")
     _check_model_size(s)
     _check_track_fit(s)
     _check_observers(s)

@@ -70,7 +70,7 @@ window, 0.2 % of the whole paper_ttbi model; a 3-D block several per cent)."""
 W_DROP = 1e-17
 """Entries of W_i = A_ii^-1 A_is below this fraction of their column's largest are dropped
 (below the round-off of the column's largest entry)."""
-HELPERS = ('_ldl_solve', '_finish_half')
+HELPERS = ('ldl_solve', '_finish_half')
 """Functions the kernel calls (:func:`ttb_sim.fe.compiled.jit` compiles them first)."""
 prange = range
 """The kernel's parallel loop; numba's ``prange`` once the parallel kernel is compiled."""
@@ -208,7 +208,7 @@ class BisectedFactorization:
         return x
 
 
-def _ldl_solve(lp: np.ndarray, li: np.ndarray, lx: np.ndarray, dinv: np.ndarray,
+def ldl_solve(lp: np.ndarray, li: np.ndarray, lx: np.ndarray, dinv: np.ndarray,
                order: np.ndarray, b: np.ndarray, work: np.ndarray) -> None:
     """Solve (I + L) D (I + L)^T work = b[order] (L strictly lower, CSC): QDLDL's loops."""
     n = dinv.shape[0]
@@ -254,9 +254,9 @@ def bisected_solve(lp1: np.ndarray, li1: np.ndarray, lx1: np.ndarray, dinv1: np.
     """
     for k in prange(2):
         if k == 0:
-            _ldl_solve(lp1, li1, lx1, dinv1, order1, b, work1)
+            ldl_solve(lp1, li1, lx1, dinv1, order1, b, work1)
         else:
-            _ldl_solve(lp2, li2, lx2, dinv2, order2, b, work2)
+            ldl_solve(lp2, li2, lx2, dinv2, order2, b, work2)
     ns = sep.shape[0]
     residual = np.empty(ns)
     for s in range(ns):

@@ -141,7 +141,11 @@ def jit(kernel: Callable[..., Any], *, parallel: bool = False) -> Callable[..., 
         else:
             module = sys.modules[kernel.__module__]
             _jit_helpers(numba, module)
-            if parallel:
+            made = getattr(module, kernel.__name__, None)
+            if not parallel and getattr(made, 'py_func', None) is kernel:
+                # The kernel is also a helper of its module's other kernels: one compilation.
+                _CACHE[key] = made
+            elif parallel:
                 setattr(module, 'prange', numba.prange)
                 serial = jit(kernel)
                 assert serial is not None
@@ -153,11 +157,24 @@ def jit(kernel: Callable[..., Any], *, parallel: bool = False) -> Callable[..., 
 
 
 def _jit_helpers(numba: Any, module: Any) -> None:
-    """Compile the helpers a module's kernels call (its ``HELPERS``) in place, once."""
+    """
+    Compile the helpers a module's kernels call (its ``HELPERS``) in place, once.
+
+    A helper taken from another kernel module has that module's helpers compiled
+    first (in its own namespace), so a kernel may call another module's kernel.
+    """
     for helper in getattr(module, 'HELPERS', ()):
         function = getattr(module, helper)
-        if not hasattr(function, 'py_func'):
-            setattr(module, helper, numba.njit(cache=True, nogil=True)(function))
+        if hasattr(function, 'py_func'):
+            continue
+        home = sys.modules[function.__module__]
+        if home is not module:
+            _jit_helpers(numba, home)
+            made = getattr(home, function.__name__, None)
+            if getattr(made, 'py_func', None) is function:
+                setattr(module, helper, made)
+                continue
+        setattr(module, helper, numba.njit(cache=True, nogil=True)(function))
 
 
 def _set_numba_threads(threads: int) -> None:

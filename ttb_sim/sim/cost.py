@@ -20,10 +20,11 @@ per-step cost + messages x per-message cost. The per-step cost grows with the
 free DOFs of the structure (sparse triangular solves) and with the multibody
 cars (wheel-rail contact), times a factor for the solver variant; the
 per-message cost is the bag writer's. The constants were fitted to
-``ttb-sim run`` on the project's 2-core machine under load (moving_force_beam,
-sprung_mass_beam, ten_span_train, track_approach, paper_ttbi with qdldl;
-docs/performance.md for the variant factors): expect the real time within a
-factor of about 2 either way, more on a very different machine.
+``ttb-sim run`` and ``ttb-sim bench`` on the project's 2-core machine at a load
+average of about 1.7 (ten_span_train, live_train with qdldl and realtime,
+paper_ttbi with qdldl, reduced and reference; docs/performance.md for the
+variant factors): expect the real time within a factor of about 2 either way,
+more on a busy or very different machine.
 ``ttb-sim bench`` measures the real numbers.
 """
 
@@ -39,20 +40,23 @@ STEP_BUDGET = 20_000_000
 
 OVERHEAD_S = 0.3
 """Opening and closing the bag, first-step set-up (s)."""
-STEP_BASE_MS = 0.05
+STEP_BASE_MS = 0.02
 """Per-step cost independent of the model size (ms)."""
-STEP_PER_DOF_MS = 2.0e-4
+STEP_PER_DOF_MS = 1.2e-5
 """Per-step cost per free structural DOF (ms)."""
-CONTACT_BASE_MS = 3.0
+CONTACT_BASE_MS = 0.4
 """Per-step cost of wheel-rail contact for the first multibody car (ms)."""
-CONTACT_PER_CAR_MS = 0.9
+CONTACT_PER_CAR_MS = 0.18
 """Per-step cost of wheel-rail contact per multibody car (ms)."""
-MESSAGE_MS = 0.08
+MESSAGE_MS = 0.005
 """Cost of writing one message to the bag (ms)."""
-VARIANT_FACTOR = {'qdldl': 1.0, 'cholmod': 1.0, 'superlu_sym': 1.8, 'reference': 3.5,
-                  'reduced': 0.6}
+VARIANT_FACTOR = {'qdldl': 1.0, 'cholmod': 1.3, 'superlu_sym': 2.2, 'reference': 5.0,
+                  'reduced': 0.45, 'realtime': 0.55}
 """Per-step cost of the structure's solves and mat-vecs for each solver variant relative to
 qdldl (docs/performance.md); ``reduced`` only with multibody cars (else it is qdldl)."""
+REFERENCE_GROWTH_DOFS = 5000.0
+"""The reference's general LU fills in faster than the symmetric orders: its factor above
+grows by 1 + free DOFs / this (measured 5x qdldl's step at 1 290 DOFs, 43x at 48 594)."""
 
 
 @dataclass(frozen=True)
@@ -153,6 +157,8 @@ def estimate_cost(*, steps: int, dt: float, free_dofs: int, cars: int, frames: i
     per_step = STEP_BASE_MS + STEP_PER_DOF_MS * free_dofs
     if cars or variant != 'reduced':
         per_step *= VARIANT_FACTOR.get(variant, 1.0)
+    if variant == 'reference':
+        per_step *= 1.0 + free_dofs / REFERENCE_GROWTH_DOFS
     if cars:
         per_step += CONTACT_BASE_MS + CONTACT_PER_CAR_MS * (cars - 1)
     messages = frames * messages_per_frame

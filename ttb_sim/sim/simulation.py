@@ -35,6 +35,7 @@ from ttb_sim.model.constants import GRAVITY
 from ttb_sim.model.vehicle.train import MultibodyCars
 from ttb_sim.sim.build import (build_coupling, build_structure, build_vehicle, observer_rows,
                                vehicle_track_setup)
+from ttb_sim.sim.coupling import FusedCoupling
 from ttb_sim.sim.cost import CostEstimate, estimate_cost, STEP_BUDGET
 from ttb_sim.sim.frames import Frame, Layout
 from ttb_sim.sim.integrators.newmark import Newmark
@@ -138,7 +139,9 @@ class Simulation:
         with blas_threads(self.variant.blas_threads):
             self.integrator = Newmark(st.mass, st.damping, st.stiffness, dt,
                                       method=self.variant.factorization,
-                                      lean=self.variant.lean)
+                                      lean=self.variant.lean,
+                                      split=False if self.variant.fused else None,
+                                      fused=self.variant.fused)
             self.coupling = build_coupling(scenario, st, self.vehicle, self.integrator,
                                            self.irregularity, lean=self.variant.lean,
                                            reduced=self.variant.reduced)
@@ -154,6 +157,8 @@ class Simulation:
                              piles=tuple((p.support + 1, p.operator.n_piles) for p in st.piled),
                              soil_points=sum(len(p.operator.soil_point_names)
                                              for p in st.piled))
+        self._no_load = np.zeros(0)
+        self._state = np.zeros((3, 0))
         log.info('model: %d free DOFs, %d axles, dt = %.3g s, %d steps', st.n_free,
                  self.vehicle.axles.count, dt, self.n_steps)
 
@@ -273,7 +278,14 @@ class Simulation:
         head = self.scenario.train.start_position
         fd = self.foundations if self.foundations.active else None
         cp.start(head)
+        loop = (cp if fd is None and self.variant.fused and isinstance(cp, FusedCoupling)
+                and cp.fused() else None)
+        if loop is not None:   # compile (or load from numba's cache) before the first frame
+            loop.advance(head, self.speed, dt, 0, self.scenario.solver.divergence_limit)
         yield self._frame(0, head)
+        if loop is not None:
+            yield from self._fused_frames(loop, head)
+            return
         for step in range(1, self.n_steps + 1):
             head += self.speed * dt
             if fd is not None:
@@ -287,32 +299,72 @@ class Simulation:
             if step % self.output_every == 0:
                 yield self._frame(step, head)
 
+    def _fused_frames(self, cp: FusedCoupling, head: float) -> Iterator[Frame]:
+        """
+        Step frame to frame in the coupling's compiled loop (``realtime``, :class:`FusedCoupling`).
+
+        The same steps as the loop of :meth:`_frames`: the speed is read once per
+        frame interval (a caller changes it between frames), the divergence check
+        runs at every step inside the loop.
+        """
+        limit = self.scenario.solver.divergence_limit
+        step = 0
+        while step < self.n_steps:
+            ask = min(self.output_every - step % self.output_every, self.n_steps - step)
+            head, taken, peak = cp.advance(head, self.speed, self.dt, ask, limit)
+            step += taken
+            if taken < ask or not (math.isfinite(peak) and peak <= limit):
+                self._diverged(step, peak)
+            if step % self.output_every == 0:
+                yield self._frame(step, head)
+
+    def _diverged(self, step: int, peak: float) -> None:
+        """Raise the DivergenceError of a state whose largest displacement is ``peak``."""
+        limit = self.scenario.solver.divergence_limit
+        raise DivergenceError(
+            f'solution diverged at t = {step * self.dt:.6g} s (step {step}): largest '
+            f'displacement {peak:.3g} m exceeds solver.divergence_limit = {limit:g} m '
+            'or is not finite; try a smaller solver.dt')
+
     def _check_state(self, step: int, *displacements: np.ndarray) -> None:
         """Raise DivergenceError if any displacement is not finite or exceeds the limit."""
         limit = self.scenario.solver.divergence_limit
         peak = max((float(np.max(np.abs(d))) for d in displacements if d.size), default=0.0)
         if not math.isfinite(peak) or peak > limit:
-            raise DivergenceError(
-                f'solution diverged at t = {step * self.dt:.6g} s (step {step}): largest '
-                f'displacement {peak:.3g} m exceeds solver.divergence_limit = {limit:g} m '
-                'or is not finite; try a smaller solver.dt')
+            self._diverged(step, peak)
 
     def _observe(self, ue: np.ndarray) -> np.ndarray:
         dofs, rows = self.observers
         return np.einsum('oij,oj->oi', rows, ue[dofs])
 
+    def _extended(self, state: tuple[np.ndarray, ...]) -> tuple[np.ndarray, ...]:
+        """
+        Return the structure state with the always-zero slot appended (as ``np.append``).
+
+        Written into one work array that the next frame overwrites: a frame keeps
+        only values gathered from it.
+        """
+        n = state[0].shape[0]
+        if self._state.shape[1] != n + 1:
+            self._state = np.zeros((len(state), n + 1))
+        for row, values in zip(self._state, state):
+            row[:n] = values
+        return tuple(self._state)
+
     def _frame(self, step: int, head: float) -> Frame:
         st, cp = self.structure, self.coupling
-        ue, ve, ae = (np.append(x, 0.0) for x in cp.structure_state())
+        ue, ve, ae = self._extended(cp.structure_state())
         vehicle = cp.vehicle_outputs()
         tops = self.foundations.tops() if self.foundations.active else None
         piles = pile_outputs(st, self.foundations, ue, ve, ae)
         if piles:
             self.rigid.update(ue[st.midspan_dofs], piles['pile_displacement'])
             self.interface.update(pile_coordinates(st, self.foundations, ue))
+        # The applied load enters only the reactions of rigid supports.
+        load = cp.structure_load(head) if st.bearings is None else self._no_load
         return Frame(step=step, time=step * self.dt, head_position=head, speed=self.speed,
                      midspan=ue[st.midspan_dofs],
-                     bearings=bearing_forces(st, ue, ve, ae, cp.structure_load(head), tops),
+                     bearings=bearing_forces(st, ue, ve, ae, load, tops),
                      body_acceleration=vehicle.body_acceleration,
                      body_angular_velocity=vehicle.body_angular_velocity,
                      wheel_rail=vehicle.wheel_rail, observers=self._observe(ue), **piles)

@@ -67,6 +67,10 @@ class SolverVariant:
     pile_soil_scheme: str = 'mixed'
     """Scheme of a pile-soil substructure run (:mod:`ttb_sim.sim.substructure.stepping`):
     'implicit' or 'mixed'."""
+    fused: bool = False
+    """True to take the steps between frames in the coupling's compiled loop
+    (:class:`~ttb_sim.sim.coupling.base.FusedCoupling`), one thread, the effective
+    matrix factorised whole (not split)."""
 
     @property
     def pile_soil_factorization(self) -> str:
@@ -86,6 +90,7 @@ VARIANTS = {
     'qdldl': SolverVariant('qdldl', 'qdldl', lean=True, blas_threads=1),
     'superlu_sym': SolverVariant('superlu_sym', 'superlu_sym', lean=True, blas_threads=1),
     'reduced': SolverVariant('reduced', 'qdldl', lean=True, blas_threads=1, reduced=True),
+    'realtime': SolverVariant('realtime', 'qdldl', lean=True, blas_threads=1, fused=True),
 }
 """Every variant by name (the choices of ``solver.variant``)."""
 

@@ -22,11 +22,12 @@ girder loads and rows of points on beams (``girder_load``) and the irregularity
 profile's interpolation as a kernel helper (``profile_kernels``).
 """
 
-from ttb_sim.sim.coupling.base import Coupling, girder_wheel_load, VehicleOutputs
+from ttb_sim.sim.coupling.base import (Coupling, FusedCoupling, girder_wheel_load,
+                                       VehicleOutputs)
 from ttb_sim.sim.coupling.moving_force import MovingForceCoupling
 from ttb_sim.sim.coupling.quarter_car import QuarterCarCoupling, QuarterCarTrain
 from ttb_sim.sim.coupling.train_track import ReducedTrainTrackCoupling, TrainTrackCoupling
 
-__all__ = ['Coupling', 'girder_wheel_load', 'MovingForceCoupling', 'QuarterCarCoupling',
+__all__ = ['Coupling', 'FusedCoupling', 'girder_wheel_load', 'MovingForceCoupling', 'QuarterCarCoupling',
            'QuarterCarTrain', 'ReducedTrainTrackCoupling', 'TrainTrackCoupling',
            'VehicleOutputs']

@@ -25,14 +25,14 @@ structure state (free DOFs) and its vehicle state, and reports what a frame need
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Protocol
+from typing import Protocol, runtime_checkable
 
 import numpy as np
 
 from ttb_sim.model.bridge import GirderLine
 from ttb_sim.sim.integrators.protocol import Integrator
 
-__all__ = ['Coupling', 'FreeDofState', 'girder_wheel_load', 'VehicleOutputs']
+__all__ = ['Coupling', 'FreeDofState', 'FusedCoupling', 'girder_wheel_load', 'VehicleOutputs']
 
 
 @dataclass(frozen=True)
@@ -78,6 +78,29 @@ class Coupling(Protocol):
 
     def vehicle_outputs(self) -> VehicleOutputs:
         """Return the vehicle's part of the current frame."""
+
+
+@runtime_checkable
+class FusedCoupling(Coupling, Protocol):
+    """
+    A coupling that can take many steps in one compiled loop (the ``realtime`` variant).
+
+    :meth:`fused` tells whether the loop is available for this model and
+    integrator; :meth:`advance` then takes the steps between two frames with the
+    same arithmetic as calling :meth:`step` once per step.
+    """
+
+    def fused(self) -> bool:
+        """Tell whether :meth:`advance` runs the compiled loop."""
+
+    def advance(self, head: float, speed: float, dt: float, steps: int,
+                limit: float) -> tuple[float, int, float]:
+        """
+        Take up to ``steps`` steps; return (head, steps taken, largest displacement).
+
+        Each step moves the head by ``speed * dt``; the loop stops after a step
+        whose largest displacement is not finite or exceeds ``limit``.
+        """
 
 
 class FreeDofState:

@@ -55,7 +55,8 @@ class Newmark:
     """
 
     def __init__(self, mass: sp.spmatrix, damping: sp.spmatrix, stiffness: sp.spmatrix,
-                 dt: float, *, method: str = 'superlu', lean: bool = False) -> None:
+                 dt: float, *, method: str = 'superlu', lean: bool = False,
+                 split: bool | None = None, fused: bool = False) -> None:
         self.dt = float(dt)
         self.a0 = 4.0 / dt**2
         self.a1 = 2.0 / dt
@@ -63,7 +64,7 @@ class Newmark:
         self.damping = sp.csr_matrix(damping)
         self.stiffness = sp.csr_matrix(stiffness)
         effective = (self.stiffness + self.a1 * self.damping + self.a0 * self.mass).tocsc()
-        self._lu = factorize(effective, method=method, split=lean)
+        self._lu = factorize(effective, method=method, split=lean if split is None else split)
         self.method = self._lu.method
         """The factorisation method in use (after any fallback)."""
         self.lean = lean
@@ -81,9 +82,34 @@ class Newmark:
         """Load added to every effective right-hand side, (DOFs (unique), values): the
         bearing forces of partitioned substructures on the girders, set before each step
         (None: none)."""
+        self._ldl: tuple[np.ndarray, ...] | None = None
+        factors = getattr(self._lu, 'factors', None)
+        if fused and lean and factors is not None:
+            lower, diagonal, permutation = factors()
+            self._ldl = (*sparse_arrays(sp.csc_matrix(lower)),
+                         1.0 / np.asarray(diagonal, dtype=np.float64),
+                         np.asarray(permutation).astype(np.uint64))
         self._history_kernel = KERNELS.compiled('history') if lean else None
         self._finish_kernel = KERNELS.compiled('finish') if lean else None
         self._load_kernel = KERNELS.compiled('effective_load') if lean else None
+
+    def fused_arrays(self) -> tuple[np.ndarray, ...] | None:
+        """
+        Return what :func:`~.newmark_kernels.newmark_ldl_step` reads, or None.
+
+        (indptr, indices, data) of the stacked [M | C], then the effective
+        matrix's QDLDL factors (column pointers, row indices and values of L,
+        1 / D, the order p); None unless the integrator was made ``fused`` (lean,
+        factorised whole by QDLDL), or with an :attr:`external` load.
+        """
+        if self._ldl is None or self.external is not None:
+            return None
+        return (*self._stacked_csr, *self._ldl)
+
+    @property
+    def history_buffer(self) -> np.ndarray:
+        """The lean step's history vector [h_a | h_v] (the stacked mat-vec's operand)."""
+        return self._history
 
     def history(self, u: np.ndarray, v: np.ndarray,
                 a: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -24,7 +24,13 @@ from __future__ import annotations
 
 import numpy as np
 
+from ttb_sim.fe.bisection import ldl_solve
 from ttb_sim.sim.kernel_registry import KernelTable
+
+HELPERS = ('history', 'effective_load', 'finish_into', 'ldl_solve', 'solve_ldl',
+           'newmark_ldl_step')
+"""Functions the kernels call (compiled first, :func:`ttb_sim.fe.compiled.jit`); the compiled
+loops of the couplings call :func:`newmark_ldl_step`."""
 
 
 def history(u: np.ndarray, v: np.ndarray, a: np.ndarray, a0: float, a1: float,
@@ -36,15 +42,21 @@ def history(u: np.ndarray, v: np.ndarray, a: np.ndarray, a0: float, a1: float,
         h_a[i] = u[i] * -a0 - v[i] * two_a1 - a[i]
 
 
+def finish_into(u: np.ndarray, a0: float, a1: float, h_v: np.ndarray, h_a: np.ndarray,
+                v: np.ndarray, a: np.ndarray) -> None:
+    """Write v = a1 u + h_v and a = a0 u + h_a (the end-of-step velocity and acceleration)."""
+    for i in range(u.shape[0]):
+        v[i] = a1 * u[i] + h_v[i]
+        a[i] = a0 * u[i] + h_a[i]
+
+
 def finish(u: np.ndarray, a0: float, a1: float, h_v: np.ndarray,
            h_a: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Return (a1 u + h_v, a0 u + h_a) as new vectors."""
     n = u.shape[0]
     v = np.empty(n)
     a = np.empty(n)
-    for i in range(n):
-        v[i] = a1 * u[i] + h_v[i]
-        a[i] = a0 * u[i] + h_a[i]
+    finish_into(u, a0, a1, h_v, h_a, v, a)
     return v, a
 
 
@@ -64,5 +76,43 @@ def effective_load(indptr: np.ndarray, indices: np.ndarray, data: np.ndarray,
         out[i] = force[i] - acc
 
 
-KERNELS = KernelTable({'effective_load': effective_load, 'history': history, 'finish': finish})
+def solve_ldl(lp: np.ndarray, li: np.ndarray, lx: np.ndarray, dinv: np.ndarray,
+              order: np.ndarray, b: np.ndarray, work: np.ndarray, x: np.ndarray) -> None:
+    """
+    Solve A x = b with A's QDLDL factors, A[p][:, p] = (I + L) D (I + L)^T (``order`` = p).
+
+    QDLDL's own loops (:func:`ttb_sim.fe.bisection.ldl_solve`), then x[p] = the
+    permuted solution; ``work`` is a vector of the same size. The same operations
+    as the ``qdldl`` wheel's solve, so the same bits (``test/sim/test_realtime.py``).
+    """
+    ldl_solve(lp, li, lx, dinv, order, b, work)
+    for i in range(order.shape[0]):
+        x[order[i]] = work[i]
+
+
+def newmark_ldl_step(indptr: np.ndarray, indices: np.ndarray, data: np.ndarray,
+                     lp: np.ndarray, li: np.ndarray, lx: np.ndarray, dinv: np.ndarray,
+                     order: np.ndarray, a0: float, a1: float, u: np.ndarray, v: np.ndarray,
+                     a: np.ndarray, force: np.ndarray, history_buffer: np.ndarray,
+                     rhs: np.ndarray, work: np.ndarray) -> None:
+    """
+    Advance u, v, a (in place) by one lean Newmark step under ``force`` (at t_{n+1}).
+
+    The lean step of :class:`~ttb_sim.sim.integrators.newmark.Newmark` in one
+    loop: :func:`history` into ``history_buffer`` = [h_a | h_v], the effective
+    load with the stacked [M | C] (CSR ``indptr``, ``indices``, ``data``), the
+    solve with the effective matrix's QDLDL factors (:func:`solve_ldl`) and
+    :func:`finish_into`.
+    """
+    n = u.shape[0]
+    h_a = history_buffer[:n]
+    h_v = history_buffer[n:]
+    history(u, v, a, a0, a1, h_v, h_a)
+    effective_load(indptr, indices, data, history_buffer, force, rhs)
+    solve_ldl(lp, li, lx, dinv, order, rhs, work, u)
+    finish_into(u, a0, a1, h_v, h_a, v, a)
+
+
+KERNELS = KernelTable({'effective_load': effective_load, 'history': history, 'finish': finish,
+                       'newmark_ldl_step': newmark_ldl_step})
 """The lean Newmark step's kernels."""

@@ -58,6 +58,13 @@ class Integrator(Protocol):
     (unique), values): the substructures' bearing forces on the girders, set through
     :meth:`~ttb_sim.sim.coupling.base.Coupling.load_bridge` before each step."""
 
+    def fused_arrays(self) -> tuple[np.ndarray, ...] | None:
+        """Return the arrays a compiled multi-step loop reads, or None (it does not apply)."""
+
+    @property
+    def history_buffer(self) -> np.ndarray:
+        """The history vector [h_a | h_v] that :meth:`history` fills (the lean step)."""
+
     def history(self, u: np.ndarray, v: np.ndarray,
                 a: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Return (h_v, h_a): v_{n+1} = a1 u_{n+1} + h_v, a_{n+1} = a0 u_{n+1} + h_a."""

@@ -43,12 +43,18 @@ directory is writable).
 
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 
 from ttb_sim.sim.coupling.profile_kernels import quintic
+from ttb_sim.sim.integrators.newmark_kernels import (effective_load, finish_into, history,
+                                                     solve_ldl)
 from ttb_sim.sim.kernel_registry import KernelTable
 
-HELPERS = ('quintic',)
+HELPERS = ('quintic', '_centreline_profile', '_wheel_terms', '_green_correction',
+           '_update_cars', 'history', 'effective_load', 'solve_ldl', 'finish_into',
+           '_largest_magnitude')
 """Functions the kernels call: :func:`ttb_sim.fe.compiled.jit` compiles them first."""
 
 
@@ -216,9 +222,91 @@ def _update_cars(u: np.ndarray, dofs: np.ndarray, w: np.ndarray, p: np.ndarray,
         contact[i] = ww + b[i]
 
 
+def _largest_magnitude(x: np.ndarray, peak: float) -> float:
+    """Return max(peak, max |x|), NaN as soon as an entry is NaN (as ``np.max`` gives)."""
+    for i in range(x.shape[0]):
+        value = abs(x[i])
+        if value != value:
+            return value
+        if value > peak:
+            peak = value
+    return peak
+
+
+def _advance_quarter_cars(head: float, speed: float, dt: float, steps: int,
+                          offsets: np.ndarray, profile: tuple[Any, ...],
+                          girder: tuple[Any, ...], cars: tuple[np.ndarray, ...],
+                          integrator: tuple[np.ndarray, ...], a0: float, a1: float,
+                          green: np.ndarray, slot: np.ndarray, state: tuple[np.ndarray, ...],
+                          wheels: tuple[np.ndarray, ...], work: tuple[np.ndarray, ...],
+                          gravity: float,
+                          limit: float) -> tuple[float, int, float]:
+    """
+    Take up to ``steps`` coupled steps of girders and quarter cars, in place.
+
+    The step of :meth:`QuarterCarCoupling._step_compiled` in one loop, the
+    girder solves with the effective matrix's QDLDL factors
+    (:func:`~ttb_sim.sim.integrators.newmark_kernels.solve_ldl`). Each step moves
+    the head by ``speed * dt``; the loop stops after the first step whose largest
+    girder or sprung-mass displacement is not finite or exceeds ``limit``.
+
+    Parameters (tuples keep the list short)
+    ---------------------------------------
+    profile : (x_start, dx, values, slopes, curvatures, slack)
+        The irregularity grid (:meth:`QuarterCarTrain._profile`); ``values`` with no
+        columns for a smooth track.
+    girder : (element length, elements, length, w_dofs)
+    cars : (sprung mass, unsprung mass, stiffness, damping, d, q)
+    integrator : (indptr, indices, data, lp, li, lx, dinv, order)
+    state : (u, v, a, z, zv, za, contact) -- girder and sprung masses
+    wheels : (positions, element, dofs, n0, w, p, b, e, hs_v, hs_a, r, r1, r2)
+    work : (history [h_a | h_v], load, x0, solve work)
+
+    Returns
+    -------
+    (head, steps taken, largest displacement of the last step)
+
+    """
+    x_start, dx, values, slopes, curvatures, slack = profile
+    h, n_el, length, w_dofs = girder
+    ms, mu, k, c, d, q = cars
+    indptr, indices, data, lp, li, lx, dinv, order = integrator
+    u, v, a, z, zv, za, contact = state
+    positions, element, dofs, n0, w, p, b, e, hs_v, hs_a, r, r1, r2 = wheels
+    buffer, load, x0, scratch = work
+    n = u.shape[0]
+    h_a = buffer[:n]
+    h_v = buffer[n:]
+    has_profile = values.shape[1] > 0
+    peak = 0.0
+    for step in range(steps):
+        head += speed * dt
+        for i in range(offsets.shape[0]):
+            positions[i] = head - offsets[i]
+        if has_profile:
+            _centreline_profile(positions, x_start, dx, values, slopes, curvatures, slack,
+                                r, r1, r2)
+        history(u, v, a, a0, a1, h_v, h_a)
+        load[:] = 0.0   # the coupling's other load is zero (as QuarterCarTrain.step)
+        effective_load(indptr, indices, data, buffer, load, load)
+        _wheel_terms(positions, speed, h, n_el, length, w_dofs, h_v, h_a, a0, a1,
+                     has_profile, r, r1, r2, ms, mu, k, c, d, q, z, zv, za, gravity, element,
+                     dofs, n0, w, p, b, e, hs_v, hs_a, load)
+        solve_ldl(lp, li, lx, dinv, order, load, scratch, x0)
+        _green_correction(x0, green, slot, dofs, n0, w, load)
+        solve_ldl(lp, li, lx, dinv, order, load, scratch, u)
+        _update_cars(u, dofs, w, p, b, e, d, hs_v, hs_a, a0, a1, z, zv, za, contact)
+        finish_into(u, a0, a1, h_v, h_a, v, a)
+        peak = _largest_magnitude(z, _largest_magnitude(u, 0.0))
+        if not peak <= limit:
+            return head, step + 1, peak
+    return head, steps, peak
+
+
 KERNELS = KernelTable({
     'centreline_profile': _centreline_profile, 'wheel_terms': _wheel_terms,
-    'green_correction': _green_correction, 'update_cars': _update_cars})
+    'green_correction': _green_correction, 'update_cars': _update_cars,
+    'advance_quarter_cars': _advance_quarter_cars})
 """The quarter cars' kernels."""
 
 

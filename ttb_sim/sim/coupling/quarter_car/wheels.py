@@ -268,6 +268,12 @@ class QuarterCarCoupling:
         return u_new, v_new, a_new
 
 
+def _fused_arrays(nm: Integrator) -> tuple[np.ndarray, ...] | None:
+    """Return the integrator's arrays of the compiled loop, or None (see Newmark.fused_arrays)."""
+    fused_arrays = getattr(nm, 'fused_arrays', None)
+    return fused_arrays() if fused_arrays is not None else None
+
+
 class QuarterCarTrain(FreeDofState):
     """
     Quarter cars on the girders as a :class:`~ttb_sim.sim.coupling.base.Coupling`.
@@ -307,6 +313,10 @@ class QuarterCarTrain(FreeDofState):
         self._r = (np.zeros(n), np.zeros(n), np.zeros(n))
         self._profile_kernel = (wheel_kernels.KERNELS.compiled('centreline_profile')
                                 if self.kernel.compiled and irregularity is not None else None)
+        self._fused: tuple[Any, ...] | None = None
+        """(kernel, integrator arrays) of the compiled loop, () without it; None: not looked."""
+        self._work: tuple[np.ndarray, ...] = ()
+        self._arguments: tuple[tuple[Any, ...], tuple[Any, ...]] | tuple[()] = ()
 
     def _profile(self, positions: np.ndarray
                  ) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
@@ -334,6 +344,56 @@ class QuarterCarTrain(FreeDofState):
         positions = head - self.cars.axles.offsets
         self.u, self.v, self.a = self.kernel.step(self.u, self.v, self.a, self._zero,
                                                   positions, speed, self._profile(positions))
+
+    def fused(self) -> bool:
+        """Tell whether :meth:`advance` runs the compiled loop (else it steps one by one)."""
+        if self._fused is None:
+            arrays = _fused_arrays(self.nm)
+            kernel = wheel_kernels.KERNELS.compiled('advance_quarter_cars')
+            ok = arrays is not None and kernel is not None and self.kernel.compiled
+            self._fused = (kernel, arrays) if ok else ()
+        return bool(self._fused)
+
+    def advance(self, head: float, speed: float, dt: float, steps: int,
+                limit: float) -> tuple[float, int, float]:
+        """
+        Take up to ``steps`` coupled steps at ``speed`` from the head at ``head`` (compiled).
+
+        Returns (head, steps taken, largest girder or sprung-mass displacement of the
+        last step); fewer steps than asked when one exceeded ``limit`` or was not finite.
+        """
+        assert self.fused(), 'advance() needs the compiled loop: check fused() first'
+        assert self._fused is not None
+        kernel = self._fused[0]
+        if not self._arguments or any(
+                held is not now for held, now in zip(self._arguments[1][0], (self.u, self.v,
+                                                                               self.a))):
+            self._arguments = self._loop_arguments()   # first call, or a new state (start)
+        before, after = self._arguments
+        out = kernel(float(head), float(speed), float(dt), int(steps), *before, *after,
+                     GRAVITY, float(limit))
+        if out[1] > 0:   # the rows of the last step are those of these positions
+            self.kernel.positions = self._work[3].copy()
+        return out
+
+    def _loop_arguments(self) -> tuple[tuple[Any, ...], tuple[Any, ...]]:
+        """Return the compiled loop's constant arguments (arrays it reads or writes in place)."""
+        k, cars, girder, n = self.kernel, self.cars, self.structure.girder, self.structure.n_free
+        assert self._fused is not None
+        self._work = (np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(cars.axles.count))
+        irr = self.irregularity
+        empty = np.zeros((4, 0))
+        profile = ((float(irr.x_start), float(irr.dx), irr.values, irr.slopes, irr.curvatures,
+                    GRID_SLACK) if irr is not None else (0.0, 1.0, empty, empty, empty, 0.0))
+        before = (cars.axles.offsets.astype(np.float64), profile,
+                  (float(girder.element_length), girder.n_spans * girder.elements_per_span,
+                   float(girder.length), girder.w_dofs),
+                  (cars.sprung_mass, cars.unsprung_mass, cars.stiffness, cars.damping,
+                   k._d, k._q), self._fused[1], self.nm.a0, self.nm.a1, k._green, k._slot)
+        after = ((self.u, self.v, self.a, k.z, k.v, k.a, k.contact),
+                 (self._work[3], k.element, k._dofs, k.n0, k._w, k._p, k._b, k._e, k._hs_v,
+                  k._hs_a, *self._r), (self.nm.history_buffer, *self._work[:3]))
+        return before, after
 
     def structure_load(self, head: float) -> np.ndarray:
         """Return the wheel contact forces (the static loads at the start) on all DOFs."""
