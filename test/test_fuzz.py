@@ -311,7 +311,7 @@ class _Hung(BaseException):
     """Raised by the alarm: an example ran longer than HANG_SECONDS."""
 
 
-EXPENSIVE = ('ttb_sim.commands.run.make_runner', 'ttb_sim.commands.validate.run_cases',
+EXPENSIVE = ('ttb_sim.sim.make_runner', 'ttb_sim.commands.validate.run_cases',
              'ttb_sim.commands.sweep._Local', 'ttb_sim.commands.sweep._Dask',
              'ttb_sim.commands.bench.measure', 'ttb_sim.commands.bench.measure_isolated',
              'ttb_sim.sim.build_structure', 'ttb_sim.report.metrics.bag_metrics')

@@ -306,7 +306,7 @@ def test_control_characters_of_a_value_stay_on_one_line(capsys):
     """Found by the fuzz suite: a record separator in a case name split the message."""
     assert main(['validate', 'a\x1eb\u2028c']) == 2
     err = capsys.readouterr().err
-    assert err.startswith('ttb-sim: error: unknown validation case(s) a\\x1eb\\u2028c; allowed')
+    assert err.startswith("ttb-sim: error: unknown validation case(s) 'a\\x1eb\\u2028c'; allowed")
     assert len(err.splitlines()) == 1
 
 

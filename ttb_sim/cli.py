@@ -107,6 +107,9 @@ def _add_model_verbs(sub: Any) -> None:
                     'process (peak memory is then not per run)')
     be.add_argument('--set', dest='overrides', action='append', default=[],
                     metavar='KEY=VALUE', help='override a scenario key; repeatable')
+    be.add_argument('--threads', metavar='N,M', help='comma-separated solver.threads counts, '
+                    'e.g. 1,2: every variant runs at each, as its own row (default: the '
+                    "scenario's own setting, auto, once; * marks an automatic choice)")
 
     mo = sub.add_parser('modes', help="natural modes of a scenario's bridge, track and piled "
                         'piers nearest a frequency')
@@ -257,7 +260,7 @@ def _main(argv: Sequence[str] | None) -> int:
             return bench_command(args.scenarios, variants=args.variants,
                                  duration=args.duration, json_path=args.json,
                                  repeat=args.repeat, isolate=not args.in_process,
-                                 overrides=args.overrides)
+                                 overrides=args.overrides, threads=args.threads)
         if args.command == 'modes':
             from ttb_sim.commands.modes import modes_command
             return modes_command(args.scenario, around=args.around, count=args.count,

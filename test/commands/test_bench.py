@@ -34,12 +34,15 @@ def _check_run(run: dict) -> None:
     for key in ('scenario', 'variant', 'factorization', 'status', 'dofs', 'dt', 'steps',
                 'frames', 'simulated_time', 'build_time', 'start_time', 'step_time',
                 'ms_per_step', 'cpu_ms_per_step', 'real_time_factor', 'peak_rss_mib',
-                'difference'):
+                'compile_time', 'compile_timed', 'warmup_steps', 'timed_steps',
+                'pending_at_timing', 'threads', 'threads_requested', 'difference'):
         assert key in run, key
     assert set(run['dofs']) == {'structure', 'track', 'bridge', 'vehicle', 'substructures',
                                 'substructures_full', 'total', 'solved'}
     assert run['dofs']['solved'] <= run['dofs']['total']
-    assert set(run['difference']) == set(bn.QUANTITIES)
+    assert set(run['difference']) == set(bn.COMPARED)
+    assert run['warmup_steps'] + run['timed_steps'] == run['steps']
+    assert run['warmup_steps'] > 0
     for quantity in run['difference'].values():
         assert set(quantity) == {'rms', 'peak', 'rms_rel', 'peak_rel'}
 
@@ -76,8 +79,11 @@ def test_wheel_rail_forces_are_compared_for_multibody_cars():
     ref, fast = report['runs']
     assert ref['status'] == fast['status'] == 'ok'
     assert ref['dofs']['vehicle'] == 42 and ref['dofs']['track'] > 0
-    assert ref['difference']['wheel_rail_vertical']['rms'] == 0.0
-    assert fast['difference']['wheel_rail_vertical']['rms_rel'] < 1e-9
+    # the dynamic part of Fz over two frames is small: its round-off is relatively larger
+    for name, within in (('wheel_rail_vertical', 1e-9), ('wheel_rail_vertical_dynamic', 1e-5),
+                         ('bearings', 1e-9), ('body_vertical_acceleration', 1e-9)):
+        assert ref['difference'][name]['rms'] == 0.0, name
+        assert fast['difference'][name]['rms_rel'] < within, name
 
 
 def test_cli_table_and_json(tmp_path: Path, capsys):
@@ -155,7 +161,7 @@ def test_substructure_workload_rows_dof_counts_and_difference():
     # (test/sim/test_substructure_variants.py)
     assert 0 < fast['difference']['pile_heads']['rms_rel'] < 0.01
     table = bn.format_table(report)
-    assert 'µs/brick' in table and table.count('single_pile') == 2
+    assert 'µs/brick' in table and table.count('single_pile') == 4   # times, differences
     json.dumps(report)
 
 
@@ -186,3 +192,80 @@ def test_cli_bad_scenario_exit_2_before_any_run(capsys):
     err = capsys.readouterr().err
     assert 'no_such_scenario' in err and 'bench: single_pile' not in err
     assert err.strip().count('\n') == 0
+
+
+def test_the_timed_section_starts_after_numba_compiled_the_kernels(tmp_path: Path, monkeypatch):
+    """
+    With numba's disk cache empty, compiling is reported apart and not timed as stepping.
+
+    Each run is its own process with the cache pointed at an empty folder: its kernels
+    compile on first use. The timed section must start with nothing pending and
+    without entering the compiler again; the compile time is in its own field. No
+    assertion on how long anything took.
+    """
+    from ttb_sim.fe.compiled import available
+
+    if not available():
+        pytest.skip('numba is not installed: nothing compiles')
+    monkeypatch.setenv('NUMBA_CACHE_DIR', str(tmp_path / 'numba-cache'))
+    report = bn.bench(['track_approach'], ['qdldl'], 0.004,
+                      overrides=['train.start_position=-10'])
+    ref, fast = report['runs']
+    for run in (ref, fast):
+        _check_run(run)
+        assert run['status'] == 'ok'
+        assert run['compile_timed'] == 0.0, run['variant']   # no compiler entry while timed
+        assert run['timed_steps'] > 0 and run['ms_per_step'] is not None
+    assert fast['pending_at_timing'] == []
+    # the reference makes the single-solve rail predictor but never calls it (it solves the
+    # track in full): made, never compiled, so still pending; nothing else is
+    assert set(ref['pending_at_timing']) <= {'rail_predictor'}
+    assert fast['compile_time'] > 0.0   # the compiled contact step, compiled on first use
+    assert any(p.name.endswith('.nbi') for p in (tmp_path / 'numba-cache').rglob('*'))
+    table = bn.format_table(report)
+    assert 'compile s' in table.splitlines()[0]
+
+
+def test_threads_rows_one_per_variant_and_count():
+    report = bn.bench(TINY, ['cholmod'], 0.005, isolate=False, threads=[1, 2])
+    runs = report['runs']
+    assert [(r['variant'], r['threads_requested'], r['threads']) for r in runs] == [
+        ('reference', 1, 1), ('cholmod', 1, 1), ('reference', 2, 2), ('cholmod', 2, 2)]
+    for run in runs:
+        _check_run(run)
+        assert run['threads_choice'].endswith('(solver.threads)')
+    assert runs[2]['difference']['midspan']['rms'] == 0.0   # each count's own reference
+    table = bn.format_table(report)
+    rows = [line.split() for line in table.splitlines() if line.startswith('moving_force')]
+    assert [row[2] for row in rows] == ['1', '1', '2', '2'] * 2   # both tables
+    json.dumps(report)
+
+
+def test_default_threads_is_the_auto_choice_once():
+    (run,) = bn.bench(TINY, ['reference'], 0.002, isolate=False)['runs']
+    assert run['threads_requested'] is None and 'auto' in run['threads_choice']
+    assert bn.format_table({'runs': [run]}).splitlines()[2].split()[2].endswith('*')
+
+
+@pytest.mark.parametrize('value, shown', [('1,x', "'1,x'"), (',', "','"), ('99', '99'),
+                                          ('-1', '-1')])
+def test_cli_bad_threads_exit_2(capsys, value, shown):
+    assert main(['bench', *TINY, '--threads', value, '--in-process']) == 2
+    err = capsys.readouterr().err
+    assert err.startswith('ttb-sim: error: --threads') and shown in err
+    assert 'bench: ' not in err and err.count('\n') == 1
+
+
+def test_difference_of_the_dynamic_part_ignores_a_constant_offset():
+    """Fz dyn: each signal less its own time mean, then the one RMS difference."""
+    t = np.linspace(0.0, 1.0, 50)[:, None]
+    ref = {'wheel_rail_vertical': np.hstack([1e5 + 1e3 * np.sin(9 * t), 8e4 + 0 * t])}
+    shifted = {'wheel_rail_vertical': ref['wheel_rail_vertical'] + [500.0, -200.0]}
+    d = bn.compare(shifted, ref)
+    assert set(d) == set(bn.COMPARED)
+    assert d['wheel_rail_vertical']['rms'] > 300.0
+    assert d['wheel_rail_vertical_dynamic']['rms'] < 1e-9
+    scaled = {'wheel_rail_vertical': np.hstack([1e5 + 1.1e3 * np.sin(9 * t), 8e4 + 0 * t])}
+    dyn = bn.compare(scaled, ref)['wheel_rail_vertical_dynamic']
+    assert dyn['rms_rel'] == pytest.approx(0.1, rel=1e-9)   # the constant wheel: no dynamics
+    assert d['bearings']['rms'] is None   # no trace: nothing to compare

@@ -130,3 +130,52 @@ def test_run_exit_code_on_divergence(tmp_path: Path, capsys):
     assert code == EXIT_FAILURE == 1
     assert 'failed: solution diverged' in capsys.readouterr().err
     assert (out / 'metadata.yaml').is_file()
+
+
+def test_a_missing_scenario_file_is_refused_before_the_model_imports():
+    """`ttb-sim run /nonexistent.yaml` refuses before the model, scipy's solvers, the core."""
+    import subprocess
+    import sys
+
+    import ttb_sim
+
+    code = ('import sys\n'
+            'from ttb_sim.cli import main\n'
+            'code = main(["run", "/nonexistent/scenario.yaml"])\n'
+            'heavy = [m for m in ("ttb_sim.model", "ttb_sim.config.records", "ttb_sim.sim",\n'
+            '                     "ttb_sim.io.bag", "scipy.sparse.linalg") if m in sys.modules]\n'
+            'print(code, heavy)\n')
+    root = str(Path(ttb_sim.__file__).resolve().parents[1])
+    proc = subprocess.run([sys.executable, '-c', code], capture_output=True, text=True,
+                          env={'PYTHONPATH': root, 'PATH': '/usr/bin:/bin'}, check=False)
+    assert proc.stdout.strip() == '2 []', proc.stderr
+    assert "scenario file '/nonexistent/scenario.yaml' does not exist" in proc.stderr
+
+
+@pytest.mark.parametrize('argv', [
+    ['--set', 'solver.duration=abc', '--duration', '0.01'],
+    ['--duration', '0.01', '--set', 'solver.duration=abc'],
+    ['--set', 'solver.duration=abc', '--set', 'solver.duration=0.01'],
+])
+def test_a_bad_set_value_is_refused_whatever_overrides_it(tmp_path: Path, capsys, argv):
+    """A later option of the same key (--duration, another --set) does not hide a bad value."""
+    from ttb_sim.cli import main
+
+    out = tmp_path / 'bag'
+    assert main(['run', 'moving_force_beam', '--out', str(out), *argv]) == 2
+    err = capsys.readouterr().err
+    assert err == ("ttb-sim: error: solver.duration = 'abc': expected a number, allowed "
+                   '[0, 100000] s\n')
+    assert not out.exists()
+
+
+def test_a_bad_shortcut_value_is_refused_though_a_set_follows(tmp_path: Path, capsys):
+    from ttb_sim.cli import main
+
+    assert main(['run', 'moving_force_beam', '--out', str(tmp_path / 'b'), '--speed-kmh', '-3',
+                 '--set', 'train.speed_kmh=200']) == 2
+    assert 'train.speed_kmh = -3.0 is out of range: allowed (0, 10000] km/h' in \
+        capsys.readouterr().err
+    with pytest.raises(ScenarioError, match="solver.variant = 'turbo': allowed values"):
+        load_scenario('moving_force_beam', ['solver.variant=turbo'],
+                      [('solver.variant', 'qdldl')])

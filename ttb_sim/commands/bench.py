@@ -18,13 +18,21 @@
 For each workload (a scenario and a simulated time) every solver variant runs
 the same passage, by default each in its own Python process so that the peak
 resident memory is that run's alone. The report gives, per run: the DOF counts,
-the time step, the build time (assembly and factorisation), the start time
-(static equilibrium, first frame), the stepping wall time, milliseconds per
-step (wall and CPU time of the process: on a shared machine the CPU time is the
-steadier of the two), the real-time factor of the stepping (simulated time /
-stepping wall time), the peak memory, and the RMS and peak difference from the ``reference``
-variant of the wheel-rail forces, the girder mid-span displacements and the pile-head
-displacements.
+the time step, the threads of the parallel kernels, the build time (assembly and
+factorisation), the start time (static equilibrium, first frame), the time numba spent
+compiling the kernels on their first use (or loading them from its disk cache), the
+stepping wall time, milliseconds per step (wall and CPU time of the process: on a
+shared machine the CPU time is the steadier of the two), the real-time factor of the
+stepping (simulated time / stepping wall time), the peak memory, and the RMS and peak
+difference from the ``reference`` variant of the wheel-rail forces (and of the dynamic
+part of Fz, each wheel's force less its time mean), the bearing forces, the car-body
+vertical acceleration, the girder mid-span displacements and the pile-head
+displacements. The stepping is timed after a warm-up that compiles what it steps
+(:mod:`ttb_sim.commands.bench_runs`), so the milliseconds per step and the real-time
+factor are those of stepping, not of compiling.
+
+``threads`` runs every variant at each of several ``solver.threads`` counts, as
+separate rows (each compared with the ``reference`` row of the same count).
 
 A pile-soil substructure on its own (``single_pile``, ``pile_harmonic``: a
 scenario whose ``load.type`` is set) is measured through the same functions:
@@ -56,7 +64,7 @@ from typing import Any, Callable, Sequence
 
 import numpy as np
 
-from ttb_sim.commands.bench_runs import compare, measure, measure_isolated, QUANTITIES, Traces
+from ttb_sim.commands.bench_runs import compare, COMPARED, measure, measure_isolated, Traces
 from ttb_sim.errors import ScenarioError
 from ttb_sim.inputs import shown
 
@@ -121,9 +129,56 @@ def check_variants(names: Sequence[str]) -> list[str]:
     return ordered
 
 
+def check_threads(counts: Sequence[int]) -> list[int | None]:
+    """
+    Validate ``solver.threads`` counts; return them in order (``[None]``: none named).
+
+    None stands for the scenario's own ``solver.threads`` (0, auto, by default).
+
+    Raises
+    ------
+    ScenarioError
+        For a count that is not an integer in the key's range; the message names it.
+
+    """
+    from ttb_sim.config import key_spec
+
+    spec = key_spec('solver.threads')[2]
+    for count in counts:
+        if isinstance(count, bool) or not isinstance(count, int) or not spec.contains(count):
+            raise ScenarioError(f'--threads: {shown(count)} is not a thread count; allowed: '
+                                f'integers {spec.allowed()} (0 = auto)')
+    return list(dict.fromkeys(counts)) or [None]
+
+
+def parse_threads(text: str | None) -> list[int]:
+    """
+    Parse ``--threads 1,2`` into counts (empty for None).
+
+    Raises
+    ------
+    ScenarioError
+        For an item that is not an integer (the message names the value and the rule).
+
+    """
+    counts = []
+    for item in (text or '').split(','):
+        if not item.strip():
+            continue
+        try:
+            counts.append(int(item.strip()))
+        except ValueError:
+            raise ScenarioError(f'--threads = {shown(text)}: expected comma-separated thread '
+                                'counts, e.g. 1,2 (integers, 0 = auto)') from None
+    if text is not None and not counts:
+        raise ScenarioError(f'--threads = {shown(text)}: expected comma-separated thread '
+                            'counts, e.g. 1,2 (integers, 0 = auto)')
+    return counts
+
+
 def bench(scenarios: Sequence[str] = (), variants: Sequence[str] = (),
           duration: float | None = None, *, overrides: Sequence[str] = (),
-          repeat: int = 1, isolate: bool = True,
+          repeat: int = 1, isolate: bool = True, threads: Sequence[int] = (),
           progress: Callable[[str], None] | None = None) -> dict[str, Any]:
     """
     Measure every variant on every workload.
@@ -150,6 +205,10 @@ def bench(scenarios: Sequence[str] = (), variants: Sequence[str] = (),
         Run each measurement in its own process (default; peak memory is then
         per run). False runs in this process (faster; the peak memory is the
         process's so far).
+    threads : sequence of int
+        ``solver.threads`` counts: every variant runs at each, as its own row
+        (``threads_requested``), compared with the ``reference`` of the same
+        count; empty = the scenario's own setting (auto by default), once.
     progress : callable, optional
         Called with a short line before each run.
 
@@ -161,37 +220,57 @@ def bench(scenarios: Sequence[str] = (), variants: Sequence[str] = (),
     Raises
     ------
     ScenarioError
-        For an unknown variant, a bad scenario or a bad ``repeat`` (every
-        workload is checked before the first run).
+        For an unknown variant, a bad scenario, thread count or ``repeat``
+        (every workload is checked before the first run).
 
     """
     if repeat < 1:
         raise ScenarioError(f'--repeat = {repeat}: must be at least 1')
+    counts = check_threads(threads)
     named = scenarios or tuple(DEFAULT_WORKLOADS)
     plans = [_plan(s, variants, duration, overrides) for s in named]
     run = measure_isolated if isolate else measure
     runs: list[dict[str, Any]] = []
     for plan in plans:
-        best: dict[str, tuple[dict[str, Any], Traces]] = {}
-        for _round in range(repeat):
+        runs.extend(_bench_plan(plan, counts, repeat, run, progress))
+    return {'machine': machine(), 'runs': runs}
+
+
+_Measure = Callable[..., tuple[dict[str, Any], Traces]]
+""":func:`~ttb_sim.commands.bench_runs.measure` or its isolated twin."""
+
+
+def _bench_plan(plan: _Plan, counts: Sequence[int | None], repeat: int, run: _Measure,
+                progress: Callable[[str], None] | None) -> list[dict[str, Any]]:
+    """Run one workload's variants at every thread count; return their report rows."""
+    best: dict[tuple[str, int | None], tuple[dict[str, Any], Traces]] = {}
+    for _round in range(repeat):
+        for count in counts:
+            sets = plan.overrides if count is None else [*plan.overrides,
+                                                         f'solver.threads={count}']
             for name in plan.variants:
                 if name in plan.refusals:
                     continue
                 if progress is not None:
-                    progress(f'{plan.scenario} / {name}')
-                metrics, traces = run(plan.scenario, name, plan.duration, plan.overrides)
-                kept = best.get(name)
+                    at = '' if count is None else f' / threads {count}'
+                    progress(f'{plan.scenario} / {name}{at}')
+                metrics, traces = run(plan.scenario, name, plan.duration, sets)
+                metrics['threads_requested'] = count
+                kept = best.get((name, count))
                 if kept is None or _faster(metrics, kept[0]):
-                    best[name] = (metrics, traces if kept is None else kept[1])
-        reference = best[REFERENCE][1] if REFERENCE in best else {}
+                    best[(name, count)] = (metrics, traces if kept is None else kept[1])
+    rows: list[dict[str, Any]] = []
+    for count in counts:
+        base = best.get((REFERENCE, count))
+        reference = base[1] if base is not None else {}
         for name in plan.variants:
-            if name not in best:
-                runs.append(_refused(plan.name, name, plan.refusals.get(name, '')))
+            if (name, count) not in best:
+                rows.append(_refused(plan.name, name, plan.refusals.get(name, ''), count))
                 continue
-            metrics, traces = best[name]
+            metrics, traces = best[(name, count)]
             metrics['difference'] = compare(traces, reference)
-            runs.append(metrics)
-    return {'machine': machine(), 'runs': runs}
+            rows.append(metrics)
+    return rows
 
 
 @dataclass(frozen=True)
@@ -234,15 +313,18 @@ def _plan(scenario: str, variants: Sequence[str], duration: float | None,
     return _Plan(scenario, loaded.name, names, span, sets, refusals)
 
 
-def _refused(name: str, variant: str, message: str) -> dict[str, Any]:
+def _refused(name: str, variant: str, message: str, threads: int | None) -> dict[str, Any]:
     """Return the report row of a variant refused for the workload."""
     return {'scenario': name, 'variant': variant, 'status': 'refused', 'message': message,
+            'threads': None, 'threads_requested': threads,
             'difference': {q: {'rms': None, 'peak': None, 'rms_rel': None, 'peak_rel': None}
-                           for q in QUANTITIES}}
+                           for q in COMPARED}}
 
 
 def _faster(a: dict[str, Any], b: dict[str, Any]) -> bool:
-    return float(a['step_time']) < float(b['step_time'])
+    """Tell whether run ``a`` stepped faster than ``b`` (an untimed run is never faster)."""
+    slow = math.inf
+    return float(a['ms_per_step'] or slow) < float(b['ms_per_step'] or slow)
 
 
 def machine() -> dict[str, Any]:
@@ -279,34 +361,66 @@ def _fmt(value: float | None, spec: str) -> str:
     return format(value, spec)
 
 
+DIFFERENCES = (('Fz RMS %', 'wheel_rail_vertical'), ('Fz dyn %', 'wheel_rail_vertical_dynamic'),
+               ('Fy RMS %', 'wheel_rail_lateral'), ('bearing %', 'bearings'),
+               ('body az %', 'body_vertical_acceleration'), ('mid RMS %', 'midspan'),
+               ('pile RMS %', 'pile_heads'))
+"""The columns of the difference table: heading, quantity (RMS difference, % of the reference)."""
+
+
+def _threads(r: dict[str, Any]) -> str:
+    """Return a row's thread count for the table: '2', '1*' (auto), '-' (none)."""
+    if r.get('threads') is None:
+        return '-'
+    auto = 'auto' in str(r.get('threads_choice') or '')
+    return f'{r["threads"]}{"*" if auto else ""}'
+
+
 def format_table(report: dict[str, Any]) -> str:
-    """Return the report as a fixed-width text table."""
-    head = (f'{"scenario":17s} {"variant":11s} {"solver":11s} {"DOFs":>7s} {"solved":>7s} '
-            f'{"dt s":>7s} '
-            f'{"steps":>6s} {"build s":>7s} {"start s":>7s} {"ms/step":>8s} {"CPU ms":>8s} '
-            f'{"RTF":>8s} {"peak MiB":>8s} {"Fz RMS %":>9s} {"Fy RMS %":>9s} '
-            f'{"mid RMS %":>9s} {"mid peak m":>10s} {"pile RMS %":>10s} {"µs/brick":>8s}')
+    """
+    Return the report as fixed-width text: the times, then the differences from ``reference``.
+
+    The first table gives the sizes and times of every run, the second the RMS
+    difference (% of the reference's RMS) of every compared quantity and the mid-span
+    peak difference (m). A thread count marked ``*`` was the automatic choice.
+    """
+    head = (f'{"scenario":17s} {"variant":11s} {"thr":>3s} {"solver":11s} {"DOFs":>7s} '
+            f'{"solved":>7s} {"dt s":>7s} {"steps":>6s} {"build s":>7s} {"start s":>7s} '
+            f'{"compile s":>9s} {"ms/step":>8s} {"CPU ms":>8s} {"RTF":>8s} {"peak MiB":>8s} '
+            f'{"µs/brick":>8s}')
     lines = [head, '-' * len(head)]
     for r in report['runs']:
-        d = r['difference']
         if r['status'] == 'refused':
-            lines.append(f'{r["scenario"]:17s} {r["variant"]:11s} refused: {r["message"]}')
+            lines.append(f'{r["scenario"]:17s} {r["variant"]:11s} {_threads(r):>3s} '
+                         f'refused: {r["message"]}')
             continue
-
-        def pct(name: str) -> str:
-            rel = d[name]['rms_rel']
-            return _fmt(None if rel is None else 100.0 * rel, '9.2g')
-
         status = '' if r['status'] == 'ok' else f'  ({r["status"]})'
         lines.append(
-            f'{r["scenario"]:17s} {r["variant"]:11s} {r["factorization"]:11s} '
+            f'{r["scenario"]:17s} {r["variant"]:11s} {_threads(r):>3s} {r["factorization"]:11s} '
             f'{r["dofs"]["total"]:7d} {r["dofs"]["solved"]:7d} {r["dt"]:7.1e} {r["steps"]:6d} '
-            f'{r["build_time"]:7.2f} {r["start_time"]:7.2f} {_fmt(r["ms_per_step"], "8.3f")} '
-            f'{_fmt(r["cpu_ms_per_step"], "8.3f")} '
+            f'{r["build_time"]:7.2f} {r["start_time"]:7.2f} {r["compile_time"]:9.2f} '
+            f'{_fmt(r["ms_per_step"], "8.3f")} {_fmt(r["cpu_ms_per_step"], "8.3f")} '
             f'{_fmt(r["real_time_factor"], "8.3g")} {_fmt(r["peak_rss_mib"], "8.0f")} '
-            f'{pct("wheel_rail_vertical")} {pct("wheel_rail_lateral")} {pct("midspan")} '
-            f'{_fmt(d["midspan"]["peak"], "10.2g")} {pct("pile_heads"):>10s} '
             f'{_fmt(r.get("cpu_us_per_brick_step"), "8.3f")}{status}')
+    return '\n'.join(lines) + '\n\n' + _difference_table(report)
+
+
+def _difference_table(report: dict[str, Any]) -> str:
+    """Return the second table: the RMS differences from ``reference`` (%), and the peak."""
+    head = (f'{"scenario":17s} {"variant":11s} {"thr":>3s} '
+            + ' '.join(f'{title:>10s}' for title, _ in DIFFERENCES) + f' {"mid peak m":>10s}')
+    lines = ['difference from reference (RMS, % of its RMS; - : nothing to compare)', head,
+             '-' * len(head)]
+    for r in report['runs']:
+        if r['status'] == 'refused':
+            continue
+        d = r['difference']
+        cells = []
+        for _, name in DIFFERENCES:
+            rel = d[name]['rms_rel']
+            cells.append(_fmt(None if rel is None else 100.0 * rel, '10.2g'))
+        lines.append(f'{r["scenario"]:17s} {r["variant"]:11s} {_threads(r):>3s} '
+                     + ' '.join(cells) + f' {_fmt(d["midspan"]["peak"], "10.2g")}')
     return '\n'.join(lines)
 
 
@@ -318,12 +432,12 @@ def write_json(report: dict[str, Any], path: str | Path) -> None:
 def bench_command(scenarios: Sequence[str], *, variants: str | None = None,
                   duration: float | None = None, json_path: Path | None = None,
                   repeat: int = 1, isolate: bool = True,
-                  overrides: Sequence[str] = ()) -> int:
-    """Run ``ttb-sim bench``: print the table (and write JSON); return the exit code."""
+                  overrides: Sequence[str] = (), threads: str | None = None) -> int:
+    """Run ``ttb-sim bench``: print the tables (and write JSON); return the exit code."""
     names = [v.strip() for v in (variants or '').split(',') if v.strip()]
     report = bench(scenarios, names, duration, overrides=overrides, repeat=repeat,
-                   isolate=isolate, progress=lambda line: print(f'bench: {line}',
-                                                                file=sys.stderr))
+                   isolate=isolate, threads=parse_threads(threads),
+                   progress=lambda line: print(f'bench: {line}', file=sys.stderr))
     print(format_table(report))
     if json_path is not None:
         write_json(report, json_path)

@@ -29,15 +29,20 @@ from pathlib import Path
 import signal
 import sys
 import time
-from typing import Any, Callable, Sequence
+from typing import Any, Callable, Sequence, TYPE_CHECKING
 
 from ttb_sim import __version__
 from ttb_sim.commands.signals import signal_name, SignalHandlers, StopFlag
-from ttb_sim.config import load_scenario, Scenario
+from ttb_sim.config import load_scenario
 from ttb_sim.errors import SimulationError
-from ttb_sim.io.bag import BagRecorder, check_destination, default_bag_path, make_parents
-from ttb_sim.io.topics import PeakTracker, Topic, topic_table
-from ttb_sim.sim import CostEstimate, make_runner, Runner, STEP_BUDGET
+
+if TYPE_CHECKING:
+    from ttb_sim.config import Scenario
+    from ttb_sim.io.topics import PeakTracker, Topic
+    from ttb_sim.sim import CostEstimate, Runner
+
+# The model, the stepping core and the bag writer are imported where first needed (about a
+# second): a scenario path that does not exist is refused before them.
 
 log = logging.getLogger(__name__)
 
@@ -98,6 +103,10 @@ def run_to_bag(scenario: Scenario, out: str | Path, storage: str = 'mcap',
         Re-raised after the bag and summary have been closed and written.
 
     """
+    from ttb_sim.io.bag import BagRecorder, check_destination, make_parents
+    from ttb_sim.io.topics import PeakTracker, topic_table
+    from ttb_sim.sim import make_runner
+
     check_destination(out, storage)  # before summary.json could land in someone's folder
     out = Path(out)
     built = time.perf_counter()
@@ -207,6 +216,7 @@ def run(scenario: str | Path, *, out: str | Path | None = None, storage: str = '
     try:
         loaded, out, simulation = _set_up(scenario, out, storage, overrides, speed_kmh,
                                           duration, force)
+        from ttb_sim.io.topics import topic_table
         estimate = simulation.plan(len(topic_table(simulation.layout)))
         print(f'ttb-sim: plan: {estimate.describe()}', file=sys.stderr)
         stop.setup = False  # from here on a signal closes the bag cleanly
@@ -246,7 +256,10 @@ def _set_up(scenario: str | Path, out: str | Path | None, storage: str, override
         values.append(('train.speed_kmh', speed_kmh))
     if duration is not None:
         values.append(('solver.duration', duration))
-    loaded = load_scenario(scenario, overrides, values)
+    loaded = load_scenario(scenario, overrides, values)  # before the model's modules import
+    from ttb_sim.io.bag import check_destination, default_bag_path
+    from ttb_sim.sim import make_runner, STEP_BUDGET
+
     target = out if out is not None else default_bag_path(loaded.name)
     check_destination(target, storage)  # before the model is built: a bad --out fails at once
     log.info('set-up: building the model of %s', loaded.name)

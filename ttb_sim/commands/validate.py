@@ -20,10 +20,13 @@ import sys
 from typing import Sequence
 
 from ttb_sim.errors import ScenarioError
+from ttb_sim.inputs import shown
 from ttb_sim.validation.cases.registry import CASES, format_table, run_cases
 from ttb_sim.validation.rows import Row
 
 EXIT_OK, EXIT_FAILURE = 0, 1
+MAX_UNKNOWN_SHOWN = 5
+"""Most unknown case ids named in the refusal."""
 
 
 def _progress(i: int, n: int, case_id: str, rows: list[Row] | None, seconds: float) -> None:
@@ -44,8 +47,12 @@ def validate(cases: Sequence[str] = (), *, list_only: bool = False) -> int:
         return EXIT_OK
     unknown = [c for c in cases if c not in CASES]
     if unknown:
-        raise ScenarioError(f'unknown validation case(s) {", ".join(unknown)}; allowed: '
-                            f'{", ".join(CASES)}')
+        # every value through shown(): bounded, quoted, control characters escaped
+        named = ', '.join(shown(c) for c in unknown[:MAX_UNKNOWN_SHOWN])
+        more = f' and {len(unknown) - MAX_UNKNOWN_SHOWN} more' if (
+            len(unknown) > MAX_UNKNOWN_SHOWN) else ''
+        raise ScenarioError(f'unknown validation case(s) {named}{more}; allowed: '
+                            f'{", ".join(CASES)} (see `ttb-sim validate --list`)')
     rows = run_cases(cases or list(CASES), progress=_progress)
     print(format_table(rows))
     failed = sum(not r.passed for r in rows)

@@ -18,18 +18,54 @@ Scenario configuration: the records, the schema walker and the YAML loader.
 ``records`` holds one frozen dataclass per scenario section, ``schema`` walks
 their declarations (keys, types, ranges) and builds them from plain data, and
 ``loader`` reads YAML files, built-ins and ``--set`` overrides.
+
+The names below are imported when first used (PEP 562): the records import the
+model's parameter records (and through them scipy), about a second, which a verb
+refusing a scenario path that does not exist should not wait for. The loader
+reads and parses the file before it needs the records.
 """
 
-from ttb_sim.config.loader import (apply_overrides, builtin_scenarios, config_dirs, load_scenario,
-                                   parse_override, read_yaml, resolve)
-from ttb_sim.config.records import (car_layout, IrregularityConfig, Observer, OBSERVER_COMPONENTS,
-                                    OutputConfig, parse_observers, Scenario, SolverConfig,
-                                    TrainConfig)
-from ttb_sim.config.schema import from_mapping, iter_keys, key_spec, to_plain
-from ttb_sim.declarations import param, Spec
+from __future__ import annotations
+
+import importlib
+from typing import Any, TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from ttb_sim.config.loader import (apply_overrides, builtin_scenarios, config_dirs,
+                                       load_scenario, parse_override, read_yaml, resolve)
+    from ttb_sim.config.records import (car_layout, IrregularityConfig, Observer,
+                                        OBSERVER_COMPONENTS, OutputConfig, parse_observers,
+                                        Scenario, SolverConfig, TrainConfig)
+    from ttb_sim.config.schema import from_mapping, iter_keys, key_spec, to_plain
+    from ttb_sim.declarations import param, Spec
+
+_FACE = {
+    'ttb_sim.config.loader': ('apply_overrides', 'builtin_scenarios', 'config_dirs',
+                              'load_scenario', 'parse_override', 'read_yaml', 'resolve'),
+    'ttb_sim.config.records': ('car_layout', 'IrregularityConfig', 'Observer',
+                               'OBSERVER_COMPONENTS', 'OutputConfig', 'parse_observers',
+                               'Scenario', 'SolverConfig', 'TrainConfig'),
+    'ttb_sim.config.schema': ('from_mapping', 'iter_keys', 'key_spec', 'to_plain'),
+    'ttb_sim.declarations': ('param', 'Spec'),
+}
+_HOME = {name: module for module, names in _FACE.items() for name in names}
 
 __all__ = ['apply_overrides', 'builtin_scenarios', 'car_layout', 'config_dirs', 'from_mapping',
            'IrregularityConfig', 'iter_keys', 'key_spec', 'load_scenario', 'Observer',
            'OBSERVER_COMPONENTS', 'OutputConfig', 'param', 'parse_observers',
            'parse_override', 'read_yaml', 'resolve', 'Scenario', 'SolverConfig', 'Spec',
            'to_plain', 'TrainConfig']
+
+
+def __getattr__(name: str) -> Any:
+    """Import a name of the package face from its module on first use."""
+    if name not in _HOME:
+        raise AttributeError(f'module {__name__!r} has no attribute {name!r}')
+    value = getattr(importlib.import_module(_HOME[name]), name)
+    globals()[name] = value
+    return value
+
+
+def __dir__() -> list[str]:
+    """List the module's names with the face's lazily imported ones."""
+    return sorted(set(globals()) | set(__all__))

@@ -20,14 +20,16 @@ from pathlib import Path
 import re
 import sys
 import sysconfig
-from typing import Any, Sequence
+from typing import Any, Sequence, TYPE_CHECKING
 
-from ttb_sim.config.records import Scenario
-from ttb_sim.config.schema import canonical_key, from_mapping, key_spec, section_problem
+from ttb_sim.config.schema import (canonical_key, coerce_value, from_mapping, key_spec,
+                                   section_problem)
 from ttb_sim.errors import ScenarioError
 from ttb_sim.inputs import MAX_SHOWN, read_user_file, shown
 import yaml
 
+if TYPE_CHECKING:
+    from ttb_sim.config.records import Scenario  # loaded by from_mapping once the file is read
 
 MAX_SCENARIO_BYTES = 1 << 20
 """Largest scenario file read (bytes): built-ins are about 2 kB."""
@@ -296,11 +298,17 @@ def apply_overrides(data: dict[str, Any], overrides: Sequence[tuple[str, Any]]) 
     """
     Set dotted keys in nested plain data, in place.
 
+    Every value is checked against its key's declaration as it is applied, so a
+    bad value is refused even where a later override of the same key (``--set
+    solver.duration=abc --duration 2``) would replace it.
+
     Raises
     ------
     ScenarioError
-        If a key does not exist in the schema, or names a section (a group of
-        keys such as ``train``) instead of a key.
+        If a key does not exist in the schema, names a section (a group of
+        keys such as ``train``) instead of a key, or is given a value of the
+        wrong type or out of range (the message names the key, the value and
+        what is allowed).
 
     """
     for key, value in overrides:
@@ -308,8 +316,9 @@ def apply_overrides(data: dict[str, Any], overrides: Sequence[tuple[str, Any]]) 
         if problem is not None:
             message = f'{key} = {shown(value)}: {problem}'
             raise ScenarioError(message)
-        key_spec(key)  # raises on unknown keys
+        typ, _, spec = key_spec(key)  # raises on unknown keys
         key = canonical_key(key)
+        coerce_value(key, value, typ, spec)  # raises on a bad value, whatever follows
         node = data
         parts = key.split('.')
         for part in parts[:-1]:

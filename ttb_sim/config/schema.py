@@ -33,7 +33,7 @@ from ttb_sim.declarations import Spec
 from ttb_sim.errors import ModelError, ScenarioError
 from ttb_sim.inputs import shown
 
-__all__ = ['ALIASES', 'canonical_key', 'from_mapping', 'iter_keys', 'key_spec',
+__all__ = ['ALIASES', 'canonical_key', 'coerce_value', 'from_mapping', 'iter_keys', 'key_spec',
            'resolve_aliases', 'section_problem', 'to_plain']
 
 ALIASES = {
@@ -261,6 +261,19 @@ def _coerce(path: str, value: Any, typ: Any, spec: Spec) -> Any:
     if typ in (float, int):
         return _coerce_number(path, value, typ, spec)
     raise TypeError(f'unsupported schema type {typ!r} for {path}')  # pragma: no cover
+
+
+def coerce_value(path: str, value: Any, typ: Any, spec: Spec) -> Any:
+    """
+    Check one value of key ``path`` against its declared type and range; return it typed.
+
+    Raises
+    ------
+    ScenarioError
+        Naming the key, the value and what is allowed.
+
+    """
+    return _coerce(path, value, typ, spec)
 
 
 def _record_item(typ: Any) -> type | None:

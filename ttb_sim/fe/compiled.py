@@ -28,16 +28,20 @@ threads a parallel kernel may take; with one, every parallel kernel runs its
 serial compilation (no thread pool is started, nothing spins). numba is
 imported only here, so the package imports without it and quickly.
 :func:`pending` tells which of the kernels made so far are neither compiled nor
-in numba's disk cache: the ones the next steps will compile.
+in numba's disk cache: the ones the next steps will compile; :func:`compile_clock`
+measures the time spent in numba's compiler (compiling, or loading a kernel from
+the disk cache) inside a ``with`` block.
 """
 
 from __future__ import annotations
 
 from contextlib import contextmanager
+from dataclasses import dataclass
 import importlib.util
 import logging
 import sys
 import threading
+import time
 from typing import Any, Callable, Iterator
 
 import numpy as np
@@ -206,3 +210,56 @@ def _in_disk_cache(kernel: Callable[..., Any]) -> bool:
     except Exception:  # noqa: B902 - numba's cache layout is internal; any failure: not cached
         return False
     return bool(index)
+
+
+@dataclass
+class CompileClock:
+    """The time numba's compiler took inside a :func:`compile_clock` block, so far."""
+
+    seconds: float = 0.0
+    """Wall seconds inside the compiler (compiling, or loading from the disk cache)."""
+    entries: int = 0
+    """How many times the compiler was entered (outermost entries only)."""
+    _depth: int = 0
+    _since: float = 0.0
+
+    def enter(self) -> None:
+        """Note an entry into the compiler (nested entries are not counted again)."""
+        if self._depth == 0:
+            self._since = time.perf_counter()
+            self.entries += 1
+        self._depth += 1
+
+    def leave(self) -> None:
+        """Note a return from the compiler."""
+        self._depth -= 1
+        if self._depth == 0:
+            self.seconds += time.perf_counter() - self._since
+
+
+@contextmanager
+def compile_clock() -> Iterator[CompileClock]:
+    """
+    Measure the time spent in numba's compiler inside a ``with`` block.
+
+    Every kernel's first call in a process enters the compiler (numba's global
+    compiler lock), whether it compiles or loads the kernel from the disk cache;
+    the clock sums those entries' wall time. Without numba it stays at zero.
+    Use: ``with compile_clock() as clock: ...``, then read ``clock.seconds``.
+    """
+    clock = CompileClock()
+    if not available():
+        yield clock
+        return
+    from numba.core import event
+
+    class _Listener(event.Listener):
+
+        def on_start(self, _event: Any) -> None:
+            clock.enter()
+
+        def on_end(self, _event: Any) -> None:
+            clock.leave()
+
+    with event.install_listener('numba:compiler_lock', _Listener()):
+        yield clock
