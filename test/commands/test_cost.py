@@ -58,8 +58,8 @@ def test_the_estimate_grows_with_steps_dofs_cars_and_variant() -> None:
     assert estimate_cost(**{**kw, 'variant': 'reduced'}).wall_time == base
     # the compiled loop of moving forces and quarter cars is cheaper than qdldl's steps
     assert estimate_cost(**{**kw, 'variant': 'realtime'}).wall_time < base
-    assert 'estimated 10.3 min' in estimate_cost(**{**kw, 'steps': 10**6,
-                                                     'free_dofs': 50_000}).describe()
+    large = {**kw, 'steps': 10**6, 'free_dofs': 50_000}
+    assert 'estimated 10.3 min' in estimate_cost(**large).describe()
 
 
 @pytest.mark.parametrize('sets, words', [

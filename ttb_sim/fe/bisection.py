@@ -209,7 +209,7 @@ class BisectedFactorization:
 
 
 def ldl_solve(lp: np.ndarray, li: np.ndarray, lx: np.ndarray, dinv: np.ndarray,
-               order: np.ndarray, b: np.ndarray, work: np.ndarray) -> None:
+              order: np.ndarray, b: np.ndarray, work: np.ndarray) -> None:
     """Solve (I + L) D (I + L)^T work = b[order] (L strictly lower, CSC): QDLDL's loops."""
     n = dinv.shape[0]
     for i in range(n):

@@ -28,6 +28,6 @@ from ttb_sim.sim.coupling.moving_force import MovingForceCoupling
 from ttb_sim.sim.coupling.quarter_car import QuarterCarCoupling, QuarterCarTrain
 from ttb_sim.sim.coupling.train_track import ReducedTrainTrackCoupling, TrainTrackCoupling
 
-__all__ = ['Coupling', 'FusedCoupling', 'girder_wheel_load', 'MovingForceCoupling', 'QuarterCarCoupling',
-           'QuarterCarTrain', 'ReducedTrainTrackCoupling', 'TrainTrackCoupling',
-           'VehicleOutputs']
+__all__ = ['Coupling', 'FusedCoupling', 'girder_wheel_load', 'MovingForceCoupling',
+           'QuarterCarCoupling', 'QuarterCarTrain', 'ReducedTrainTrackCoupling',
+           'TrainTrackCoupling', 'VehicleOutputs']

@@ -365,9 +365,9 @@ class QuarterCarTrain(FreeDofState):
         assert self.fused(), 'advance() needs the compiled loop: check fused() first'
         assert self._fused is not None
         kernel = self._fused[0]
-        if not self._arguments or any(
-                held is not now for held, now in zip(self._arguments[1][0], (self.u, self.v,
-                                                                               self.a))):
+        state = (self.u, self.v, self.a)
+        if not self._arguments or any(held is not now
+                                      for held, now in zip(self._arguments[1][0], state)):
             self._arguments = self._loop_arguments()   # first call, or a new state (start)
         before, after = self._arguments
         out = kernel(float(head), float(speed), float(dt), int(steps), *before, *after,
