@@ -35,8 +35,8 @@ from ttb_sim.model.constants import GRAVITY
 from ttb_sim.model.vehicle.train import MultibodyCars
 from ttb_sim.sim.build import (build_coupling, build_structure, build_vehicle, observer_rows,
                                vehicle_track_setup)
-from ttb_sim.sim.coupling import FusedCoupling
 from ttb_sim.sim.cost import CostEstimate, estimate_cost, STEP_BUDGET
+from ttb_sim.sim.coupling import FusedCoupling
 from ttb_sim.sim.frames import Frame, Layout
 from ttb_sim.sim.integrators.newmark import Newmark
 from ttb_sim.sim.substructure.piled_piers import (InterfaceCheck, pile_coordinates, pile_outputs,
