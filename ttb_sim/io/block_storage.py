@@ -385,6 +385,7 @@ class SqliteBlockStorage(Sqlite3Writer):
     def __init__(self, path: Path, compression: CompressionMode) -> None:
         super().__init__(path, compression)
         self.pending = 0                # bytes inserted since the last commit
+        self.uncommitted = 0            # messages inserted since the last commit
         self.since: int | None = None   # the first stamp since the last commit (ns)
 
     def write_frames(self, ids: np.ndarray, records: np.ndarray, starts: np.ndarray,
@@ -413,10 +414,11 @@ class SqliteBlockStorage(Sqlite3Writer):
                                                  map(flat.__getitem__, slices)))
         if n:
             self.pending += records.size
+            self.uncommitted += n * len(ids)
             self.since = int(stamps[0]) if self.since is None else self.since
             if self.pending > CHUNK_BYTES or int(stamps[-1]) - self.since >= CHUNK_SPAN_NS:
                 self.conn.commit()   # a killed recording keeps every committed block
-                self.pending, self.since = 0, None
+                self.pending, self.uncommitted, self.since = 0, 0, None
 
 
 class BlockWriter(Writer):

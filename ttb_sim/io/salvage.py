@@ -39,7 +39,7 @@ import struct
 import tempfile
 from typing import Any, Iterable, Iterator
 
-from mcap.exceptions import EndOfFile, McapError
+from mcap.exceptions import EndOfFile, McapError, RecordLengthLimitExceeded
 from mcap.records import Channel, Message, Schema
 from mcap.stream_reader import StreamReader
 from rosbags.interfaces import (Connection, ConnectionExtRosbag2, MessageDefinition,
@@ -155,7 +155,7 @@ def _mcap(file: Path) -> Salvage:
                     channels.setdefault(record.id, record)
                 elif isinstance(record, Schema):
                     schemas.setdefault(record.id, record)
-        except EndOfFile:
+        except (EndOfFile, RecordLengthLimitExceeded):   # a record longer than the rest
             stop = 'the file ends inside a record'
         except _DAMAGED as exc:
             stop = f'a damaged record ({type(exc).__name__}' + (
