@@ -73,7 +73,7 @@ def recover(bag: str | Path, *, out: str | Path | None = None) -> int:
     if summary.is_file():
         shutil.copyfile(summary, target / 'summary.json')
     state = 'was closed' if found.closed else 'was not closed'
-    stop = f'; read up to {found.stop}' if found.stop else ''
+    stop = f'; {found.stop}' if found.stop else ''
     print(f'{target}: {written} messages recovered from {file} ({state}{stop}): '
           f'{found.describe()}')
     return EXIT_OK

@@ -39,7 +39,7 @@ import struct
 import tempfile
 from typing import Any, Iterable, Iterator
 
-from mcap.exceptions import EndOfFile, McapError, RecordLengthLimitExceeded
+from mcap.exceptions import EndOfFile, InvalidMagic, McapError, RecordLengthLimitExceeded
 from mcap.records import Channel, Message, Schema
 from mcap.stream_reader import StreamReader
 from rosbags.interfaces import (Connection, ConnectionExtRosbag2, MessageDefinition,
@@ -130,8 +130,7 @@ def salvage(file: Path) -> Salvage:
         what = 'chunk' if found.storage == 'mcap' else 'committed transaction'
         why = f' ({found.stop})' if found.stop else ''
         raise BagError(f'nothing to recover in {str(file)!r}: it holds no message in a '
-                       f'complete {what}{why}; the recording was stopped before its '
-                       'first one was written')
+                       f'complete {what}{why}')
     return found
 
 
@@ -157,6 +156,8 @@ def _mcap(file: Path) -> Salvage:
                     schemas.setdefault(record.id, record)
         except (EndOfFile, RecordLengthLimitExceeded):   # a record longer than the rest
             stop = 'the file ends inside a record'
+        except InvalidMagic:
+            stop = 'it does not begin with the MCAP magic: not an MCAP file'
         except _DAMAGED as exc:
             stop = f'a damaged record ({type(exc).__name__}' + (
                 f': {one_line(str(exc))})' if str(exc) else ')')
