@@ -123,10 +123,22 @@ def _add_model_verbs(sub: Any) -> None:
 
 
 def _add_bag_verbs(sub: Any) -> None:
-    """Add analyze and compare (they read bags), sweep (many runs, analysed) and scenarios."""
+    """Add analyze, recover and compare (they read bags), sweep (many runs) and scenarios."""
     an = sub.add_parser('analyze', help='figures, metrics.json and index.html from a bag')
     an.add_argument('bag', help='bag directory (metadata.yaml + .mcap/.db3) or storage file')
     an.add_argument('--out', type=Path, help='output folder (default: BAG/analysis)')
+
+    re_ = sub.add_parser(
+        'recover', help='rewrite a bag a killed run left (no metadata.yaml, MCAP without '
+        'summary) as a new, closed bag', description='Read the storage file of a bag whose '
+        'recording was killed (SIGKILL, power cut) up to its last complete MCAP chunk or '
+        'SQLite 3 commit, and write those messages as a new bag of the same storage with a '
+        'fresh metadata.yaml (summary.json copied if there is one). The original is only '
+        'read. `ttb-sim analyze` reads such a bag directly too, with a warning. Exit 2 when '
+        'nothing complete can be read back.')
+    re_.add_argument('bag', help='bag directory or its .mcap / .db3 file')
+    re_.add_argument('--out', help='new bag directory to create (default: BAG-recovered '
+                     'beside the bag)')
 
     co = sub.add_parser('compare', help='the analysis figures of several bags overlaid, with a '
                         'table of differences')
@@ -246,6 +258,9 @@ def _main(argv: Sequence[str] | None) -> int:
         if args.command == 'analyze':
             from ttb_sim.commands.analyze import analyze
             return analyze(args.bag, out=args.out)
+        if args.command == 'recover':
+            from ttb_sim.commands.recover import recover
+            return recover(args.bag, out=args.out)
         if args.command == 'compare':
             from ttb_sim.commands.compare import compare
             return compare(args.bags, labels=args.labels, out=args.out)

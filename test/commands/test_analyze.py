@@ -175,9 +175,9 @@ def test_bad_input_exit_2_without_traceback(bag, tmp_path, capsys):
     (truncated / 'metadata.yaml').write_bytes((bag / 'metadata.yaml').read_bytes())
     data = next(bag.glob('*.mcap')).read_bytes()
     (truncated / next(bag.glob('*.mcap')).name).write_bytes(data[:len(data) // 3])
-    killed = tmp_path / 'killed'
+    killed = tmp_path / 'killed'       # before its first chunk was written
     killed.mkdir()
-    (killed / 'bag_0.mcap').write_bytes(data[:len(data) // 3])
+    (killed / 'bag_0.mcap').write_bytes(data[:200])
     empty = tmp_path / 'clock_only'
     sb.write_bag(empty, layout=Layout(n_spans=0, n_supports=0, n_bodies=0), summary=False)
     busy = tmp_path / 'busy'
@@ -201,6 +201,24 @@ def test_bad_input_exit_2_without_traceback(bag, tmp_path, capsys):
     assert [p.name for p in busy.iterdir()] == ['thesis.tex']
     for folder in (not_bag, truncated, killed, empty):
         assert not (folder / 'analysis').exists()
+
+
+def test_a_killed_runs_bag_is_read_up_to_its_last_complete_chunk(bag, tmp_path, capsys,
+                                                                 caplog):
+    """Issue #28 6: no metadata.yaml, the MCAP file cut short: analysed, one warning line."""
+    killed = tmp_path / 'killed'
+    killed.mkdir()
+    data = next(bag.glob('*.mcap')).read_bytes()
+    (killed / 'bag_0.mcap').write_bytes(data[:len(data) * 2 // 3])
+    with caplog.at_level('WARNING'):
+        assert main(['analyze', str(killed)]) == 0
+    [warning] = [r.getMessage() for r in caplog.records if r.levelname == 'WARNING']
+    assert re.fullmatch(rf'bag {re.escape(str(killed))} was not closed \(a killed recording\?\): '
+                        r'read up to its last complete chunk: \d+ messages of \d+ topics, '
+                        r't = [\d.]+ \.\. [\d.]+ s; `ttb-sim recover .*` writes a closed copy',
+                        warning), warning
+    assert (killed / 'analysis' / 'metrics.json').is_file()
+    assert sorted(p.name for p in killed.iterdir()) == ['analysis', 'bag_0.mcap']
 
 
 def test_a_broken_metadata_file_is_one_line_exit_2(bag, tmp_path, capsys):
@@ -232,8 +250,8 @@ def test_a_cut_mcap_points_to_recovery_in_one_line(bag, tmp_path, capsys):
     err = capsys.readouterr().err
     assert err.startswith(f"ttb-sim: error: bag '{cut}' is truncated or corrupt "
                           f"('{cut / data.name}': ")
-    assert err.endswith('; a recording that was killed leaves such a file: `mcap recover` may '
-                        'rescue it\n')
+    assert err.endswith('; a recording that was killed leaves such a file: `ttb-sim recover` '
+                        'may rescue it\n')
     assert err.count('\n') == 1
 
 

@@ -224,13 +224,14 @@ def test_a_truncated_bag(written, tmp_path: Path, storage):
                                        'was killed'):
         read_bag(bag)
     (bag / 'metadata.yaml').unlink()    # rosbags writes it on close: a killed run has none
-    with pytest.raises(BagError, match=rf'has {data.name} but no metadata.yaml: the '
-                                       'recording did not finish'):
+    # read as a killed run's bag (test_salvage.py): here nothing complete is left to read
+    with pytest.raises(BagError, match=rf"^bag '{bag}': the recording did not finish \(a "
+                                       r'killed run\?\), and .*' + data.name):
         read_bag(bag)
 
 
 @pytest.mark.parametrize('storage', ['mcap', 'sqlite3'])
-def test_recovery_is_pointed_to_only_for_a_cut_mcap(written, tmp_path: Path, storage):
+def test_recovery_is_pointed_to_for_a_cut_file(written, tmp_path: Path, storage):
     paths, _ = written
     bag = tmp_path / 'cut'
     shutil.copytree(paths[storage], bag)
@@ -240,7 +241,7 @@ def test_recovery_is_pointed_to_only_for_a_cut_mcap(written, tmp_path: Path, sto
         read_bag(bag)
     message = str(info.value)
     assert '\n' not in message and f'({str(data)!r}: ' in message
-    assert message.endswith(': `mcap recover` may rescue it') == (storage == 'mcap')
+    assert message.endswith(': `ttb-sim recover` may rescue it')
 
 
 @pytest.mark.parametrize('text, message', [
@@ -262,7 +263,7 @@ def test_a_broken_metadata_file_is_named_in_one_line(written, tmp_path: Path, te
     (bag / 'metadata.yaml').write_text(text)
     with pytest.raises(BagError, match=rf"^bag metadata '{bag}/metadata.yaml' {message}") as info:
         read_bag(bag)
-    assert '\n' not in str(info.value) and 'mcap recover' not in str(info.value)
+    assert '\n' not in str(info.value) and 'recover' not in str(info.value)
     (bag / 'metadata.yaml').write_bytes(b'\xff\xfe')
     with pytest.raises(BagError, match=r'metadata.yaml. cannot be read: not UTF-8 text'):
         bag_topics(bag)

@@ -53,10 +53,13 @@ log = logging.getLogger(__name__)
 
 STORAGES = {'mcap': StoragePlugin.MCAP, 'sqlite3': StoragePlugin.SQLITE3}
 """Storage back-ends by their rosbag2 plugin names."""
-BLOCK_BYTES = 4 * 2 ** 20
+BLOCK_BYTES = 2 ** 18
 """About how many bytes of messages a block of frames holds before it is written."""
 MAX_BLOCK_FRAMES = 512
 """The most frames a block holds (a live node's bag gets them at most this late)."""
+BLOCK_SPAN_NS = 250_000_000
+"""A block is written once its frames span this long (ns, simulated): a killed
+recording loses at most a block and the storage's open chunk."""
 _REASONS = {errno.EROFS: 'read-only file system', errno.EACCES: 'permission denied',
             errno.EPERM: 'permission denied'}
 
@@ -288,7 +291,8 @@ class BagRecorder:
             self._set_width(row.size, frame.time)
         self._rows.append(row)
         self._stamps.append(frame.stamp_ns)
-        if len(self._rows) == self._capacity:
+        if len(self._rows) == self._capacity or \
+                self._stamps[-1] - self._stamps[0] >= BLOCK_SPAN_NS:
             self.flush()
 
     def _set_width(self, width: int, time: float) -> None:

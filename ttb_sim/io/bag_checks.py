@@ -18,10 +18,11 @@ Bag files that cannot be read, said in one line: what is wrong with which file.
 :func:`check_metadata` refuses a ``metadata.yaml`` that is not YAML or not
 rosbag2 metadata before rosbags reads it (its own messages quote the YAML
 parser over several lines); :func:`unreadable` words what rosbags or a damaged
-storage file raised, pointing to ``mcap recover`` only for an MCAP file cut
-short; :func:`one_line` bounds a library's message. :func:`check_bag_path` makes
-every check that needs no bag library, so that a verb can refuse a wrong path
-before it imports one.
+storage file raised, pointing to ``ttb-sim recover``; :func:`one_line` bounds a
+library's message. :func:`check_bag_path` makes every check that needs no bag
+library, so that a verb can refuse a wrong path before it imports one;
+:func:`unclosed_file` tells the storage file of a bag whose recording did not
+finish (read by :mod:`ttb_sim.io.salvage` instead of rosbags).
 """
 
 from __future__ import annotations
@@ -32,10 +33,20 @@ import re
 from ttb_sim.errors import BagError
 import yaml
 
-__all__ = ['check_bag_path', 'check_metadata', 'MAX_METADATA_BYTES', 'one_line', 'unreadable']
+__all__ = ['check_bag_path', 'check_metadata', 'MAX_METADATA_BYTES', 'MCAP_MAGIC', 'one_line',
+           'SIDE_FILES', 'unclosed_file', 'unreadable']
 
 MAX_METADATA_BYTES = 64 << 20
 """Largest ``metadata.yaml`` read (bytes); ours are about 100 bytes per topic."""
+
+MCAP_MAGIC = b'\x89MCAP0\r\n'
+"""The bytes an MCAP file begins with and, once closed, ends with."""
+
+SIDE_FILES = ('-journal', '-wal')
+"""What SQLite 3 leaves beside a database whose writer did not finish a transaction."""
+
+RECOVER = '`ttb-sim recover` may rescue it'
+"""The advice for a storage file cut short or damaged."""
 
 MAX_DETAIL = 300
 """Most characters of a reader's own message quoted in a BagError."""
@@ -68,8 +79,9 @@ def check_bag_path(path: Path) -> None:
     BagError
         If ``path`` does not exist, is a file other than ``.mcap`` / ``.db3``,
         neither a file nor a directory, a directory without ``metadata.yaml``
-        (a killed recording, when it holds storage files) or with a
-        ``metadata.yaml`` that :func:`check_metadata` refuses.
+        and with no storage file or several (one alone is a recording that
+        did not finish: :func:`unclosed_file`), or with a ``metadata.yaml``
+        that :func:`check_metadata` refuses.
 
     """
     try:
@@ -88,16 +100,46 @@ def check_bag_path(path: Path) -> None:
     if not path.is_dir():
         raise BagError(f'{str(path)!r} is not a bag: neither a file nor a directory')
     if not (path / 'metadata.yaml').is_file():
-        storage = sorted(p.name for p in path.iterdir() if p.suffix in ('.mcap', '.db3'))
+        storage = _storage_files(path)
+        if len(storage) == 1:    # a recording that did not finish: read by salvage
+            return
         if storage:
-            tools = '`ros2 bag reindex` or `mcap recover`' if any(
-                name.endswith('.mcap') for name in storage) else '`ros2 bag reindex`'
-            msg = f'{str(path)!r} has {", ".join(storage)} but no metadata.yaml: the ' \
-                  f'recording did not finish (a killed run?); {tools} may rescue it'
+            msg = f'{str(path)!r} has {", ".join(p.name for p in storage)} but no ' \
+                  'metadata.yaml: the recording did not finish (a killed run?); give ' \
+                  '`ttb-sim recover` one storage file at a time'
         else:
             msg = f'{str(path)!r} is not a rosbag2 directory (no metadata.yaml)'
         raise BagError(msg)
     check_metadata(path / 'metadata.yaml')
+
+
+def _storage_files(folder: Path) -> list[Path]:
+    return sorted(p for p in folder.iterdir() if p.suffix in ('.mcap', '.db3') and p.is_file())
+
+
+def unclosed_file(path: Path) -> Path | None:
+    """
+    Return the storage file of a bag whose recording did not finish, or None.
+
+    That is the one storage file of a directory without ``metadata.yaml``
+    (rosbag2 writes it on close), an ``.mcap`` file that does not end with its
+    footer's magic, or a ``.db3`` file beside a hot journal (``-journal``,
+    ``-wal``). Call after :func:`check_bag_path`.
+    """
+    if path.is_dir():
+        if (path / 'metadata.yaml').is_file():
+            return None
+        storage = _storage_files(path)
+        return storage[0] if len(storage) == 1 else None
+    if path.suffix == '.db3':
+        return path if any(path.with_name(path.name + s).exists() for s in SIDE_FILES) \
+            else None
+    try:
+        with path.open('rb') as stream:
+            stream.seek(max(path.stat().st_size - len(MCAP_MAGIC), 0))
+            return None if stream.read() == MCAP_MAGIC else path
+    except OSError:
+        return None     # rosbags says what is wrong
 
 
 def check_metadata(path: Path) -> None:
@@ -171,8 +213,5 @@ def unreadable(path: Path, exc: Exception) -> str:
     files = [path] if path.is_file() else sorted(
         p for p in path.iterdir() if p.suffix in ('.mcap', '.db3'))
     which = f'{str(files[0])!r}' if len(files) == 1 else 'a storage file'
-    msg = f'bag {str(path)!r} is truncated or corrupt ({which}: {detail}); a recording that ' \
-          'was killed leaves such a file'
-    if all(p.suffix == '.mcap' for p in files) and files:
-        msg += ': `mcap recover` may rescue it'
-    return msg
+    return f'bag {str(path)!r} is truncated or corrupt ({which}: {detail}); a recording that ' \
+        f'was killed leaves such a file: {RECOVER}'

@@ -29,7 +29,17 @@ that takes them past 1 MiB, one message index per channel and chunk, the
 ``rosbag2`` metadata record, the summary with chunk indexes and statistics,
 CRCs left 0) but takes the message records of many frames as one byte array
 (:class:`~ttb_sim.io.codec.BlockEncoder`) and indexes them with numpy. Only
-the file's ``library`` field differs: it names ttb_sim.
+the file's ``library`` field differs: it names ttb_sim; and a chunk is also
+closed before a message logged :data:`CHUNK_SPAN_NS` (1 s, simulated) or more
+after the chunk's first one, which only a lean bag (under 1 MiB a second) meets.
+
+What a killed recording leaves: every closed chunk is handed to the operating
+system at once (a SIGKILL loses at most the open chunk: 1 MiB or 1 s of
+messages) and synced to the disk at most every :data:`SYNC_SECONDS` of wall
+time (a power cut loses at most that much more); :class:`SqliteBlockStorage`
+commits every block, where rosbags' storage commits once, on close.
+:mod:`ttb_sim.io.salvage` reads such a file back up to its last complete chunk
+or transaction.
 
 Neither rosbags' MCAP storage nor the ``mcap`` library's writer takes more
 than one message per call, and at about 7-9 microseconds a message (measured)
@@ -39,7 +49,9 @@ either cost more than the whole physics of a run of ours.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+import os
 from pathlib import Path
+import time
 from typing import Any, cast, Sequence
 
 import numpy as np
@@ -54,6 +66,10 @@ from ttb_sim import __version__
 MAGIC = b'\x89MCAP0\r\n'
 CHUNK_BYTES = 2 ** 20
 """A chunk is closed after the message that takes it past this size (as rosbags does)."""
+CHUNK_SPAN_NS = 10 ** 9
+"""A chunk is closed before a message logged this long (ns) after the chunk's first one."""
+SYNC_SECONDS = 1.0
+"""A closed chunk is synced to the disk (fsync) when the last sync is this old (wall s)."""
 RECORD_HEADER = 31
 """Bytes before a message record's data: opcode, length, channel, sequence, two times."""
 TIME_OFFSETS = (15, 23)
@@ -80,6 +96,20 @@ def _string(text: str | bytes) -> bytes:
 
 def _record(opcode: int, body: bytes) -> bytes:
     return bytes((opcode,)) + _u64(len(body)) + body
+
+
+def _sync_folder(folder: Path) -> None:
+    """Sync a folder's entries to the disk (where the system allows it)."""
+    try:
+        handle = os.open(folder, os.O_RDONLY)
+    except OSError:
+        return
+    try:
+        os.fsync(handle)
+    except OSError:
+        pass
+    finally:
+        os.close(handle)
 
 
 def message_prefix(channel_id: int, data_size: int) -> bytes:
@@ -134,6 +164,7 @@ class McapBlockStorage:
         self.chunk_indexes: list[bytes] = []
         self.counts: dict[int, int] = {}
         self.start, self.end = _NO_START, _NO_END
+        self.synced: float | None = None   # when the file was last synced (None: never)
 
     def add_msgtype(self, connection: Connection) -> None:
         """Add the schema of a connection's message type."""
@@ -210,9 +241,16 @@ class McapBlockStorage:
             base = int(starts[first]) - self.chunk.size  # stream offset of the chunk's start
             last = int(np.searchsorted(ends, CHUNK_BYTES + base, side='right'))
             last = min(last, len(starts) - 1)            # the message that closes the chunk
+            opened = self.chunk.start if self.chunk.channels else int(times[first])
+            late = np.flatnonzero(times[first:last + 1] >= opened + CHUNK_SPAN_NS)
+            if late.size and late[0] == 0:               # the open chunk is 1 s long already
+                self._close_chunk()
+                continue
+            if late.size:
+                last = first + int(late[0]) - 1          # the last message within 1 s
             self._append(stream, starts[first:last + 1], int(ends[last]), base,
                          channels[first:last + 1], times[first:last + 1])
-            if self.chunk.size > CHUNK_BYTES:
+            if self.chunk.size > CHUNK_BYTES or late.size:
                 self._close_chunk()
             first = last + 1
         for channel, count in zip(*np.unique(channels, return_counts=True)):
@@ -247,6 +285,17 @@ class McapBlockStorage:
             _u64(chunk.start) + _u64(chunk.end) + _u64(start) + _u64(end - start)
             + _u32(len(index)) + index + _u64(self.bio.tell() - end) + _string('')
             + _u64(chunk.size) + _u64(chunk.size))
+        self._hand_over()
+
+    def _hand_over(self) -> None:
+        """Pass what is written to the operating system; sync it when the last sync is old."""
+        self.bio.flush()
+        now = time.monotonic()
+        if self.synced is None or now - self.synced >= SYNC_SECONDS:
+            os.fsync(self.bio.fileno())
+            if self.synced is None:   # the new file's name in its folder, once
+                _sync_folder(self.path.parent)
+            self.synced = now
 
     def _message_indexes(self, chunk: _Chunk) -> list[tuple[int, int]]:
         """
@@ -321,10 +370,23 @@ class McapBlockStorage:
 
 
 class SqliteBlockStorage(Sqlite3Writer):
-    """rosbags' SQLite 3 storage, inserting the messages of a block of frames at once."""
+    """
+    rosbags' SQLite 3 storage, inserting the messages of a block of frames at once.
+
+    Unlike rosbags' storage, which commits once, on close, it commits as the
+    MCAP storage closes a chunk: once the messages inserted since the last
+    commit pass :data:`CHUNK_BYTES` or span :data:`CHUNK_SPAN_NS` (checked
+    after every block), so that a killed recording keeps every committed block.
+    """
 
     INSERT = 'INSERT INTO messages (topic_id, timestamp, data) VALUES(?, ?, ?)'
     """rosbags' own statement for a message (rosbag2's ``messages`` table)."""
+
+    def __init__(self, path: Path, compression: CompressionMode) -> None:
+        super().__init__(path, compression)
+        self.pending = 0                # bytes inserted since the last commit
+        self.uncommitted = 0            # messages inserted since the last commit
+        self.since: int | None = None   # the first stamp since the last commit (ns)
 
     def write_frames(self, ids: np.ndarray, records: np.ndarray, starts: np.ndarray,
                      ends: np.ndarray, stamps: np.ndarray) -> None:
@@ -350,6 +412,13 @@ class SqliteBlockStorage(Sqlite3Writer):
         self.cursor.executemany(self.INSERT, zip(np.tile(ids, n).tolist(),
                                                  np.repeat(stamps, len(ids)).tolist(),
                                                  map(flat.__getitem__, slices)))
+        if n:
+            self.pending += records.size
+            self.uncommitted += n * len(ids)
+            self.since = int(stamps[0]) if self.since is None else self.since
+            if self.pending > CHUNK_BYTES or int(stamps[-1]) - self.since >= CHUNK_SPAN_NS:
+                self.conn.commit()   # a killed recording keeps every committed block
+                self.pending, self.uncommitted, self.since = 0, 0, None
 
 
 class BlockWriter(Writer):

@@ -66,14 +66,17 @@ from dataclasses import dataclass
 import logging
 from pathlib import Path
 import struct
-from typing import Any, Iterable, Iterator, Mapping, Sequence
+from typing import Any, Iterable, Iterator, Mapping, Sequence, TYPE_CHECKING
 
 import numpy as np
 from rosbags.rosbag2 import Reader, ReaderError
 from rosbags.serde import SerdeError
 from ttb_sim.errors import BagError
-from ttb_sim.io.bag_checks import check_bag_path, one_line, unreadable
+from ttb_sim.io.bag_checks import check_bag_path, one_line, unclosed_file, unreadable
 from ttb_sim.io.cdr import Group, groups, typestore
+
+if TYPE_CHECKING:
+    from ttb_sim.io.salvage import Salvage
 
 log = logging.getLogger(__name__)
 
@@ -268,9 +271,18 @@ CORRUPT = (ReaderError, OverflowError, EOFError, IndexError, struct.error, Memor
 # -- opening and selecting --------------------------------------------------------------
 
 @contextmanager
-def _open(path: Path) -> Iterator[Reader]:
-    """Open a bag with rosbags, translating its errors to one-line :class:`BagError`."""
+def _open(path: Path) -> Iterator[Reader | Salvage]:
+    """
+    Open a bag with rosbags, translating its errors to one-line :class:`BagError`.
+
+    A bag whose recording did not finish (:func:`~ttb_sim.io.bag_checks.unclosed_file`)
+    is read by :func:`~ttb_sim.io.salvage.salvage` instead, with a warning.
+    """
     check_bag_path(path)
+    unclosed = unclosed_file(path)
+    if unclosed is not None:
+        yield _salvage(path, unclosed)
+        return
     try:
         reader = Reader(path)
         reader.open()
@@ -283,6 +295,22 @@ def _open(path: Path) -> Iterator[Reader]:
         yield reader
     finally:
         reader.close()
+
+
+def _salvage(path: Path, file: Path) -> Salvage:
+    """Read an unclosed bag up to its last complete chunk or commit; warn in one line."""
+    from ttb_sim.io.salvage import salvage
+    try:
+        found = salvage(file)
+    except BagError as exc:
+        raise BagError(f'bag {str(path)!r}: the recording did not finish (a killed run?), '
+                       f'and {exc}') from None
+    unit = 'chunk' if found.storage == 'mcap' else 'commit'
+    state = 'has no metadata.yaml' if found.closed else \
+        f'was not closed (a killed recording?): read up to its last complete {unit}'
+    log.warning('bag %s %s: %s; `ttb-sim recover %s` writes a closed copy', path, state,
+                found.describe(), path)
+    return found
 
 
 def _select(path: Path, available: Mapping[str, str],
