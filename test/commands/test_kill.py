@@ -61,7 +61,7 @@ def _by_topic(items) -> dict[str, list[tuple[int, bytes]]]:
 
 @pytest.fixture(scope='module')
 def complete(tmp_path_factory) -> dict[str, list[tuple[int, bytes]]]:
-    """The messages of a complete run of the command, by topic."""
+    """Return the messages of a complete run of the command, by topic."""
     out = tmp_path_factory.mktemp('complete') / 'bag'
     proc = _cli('run', *RUN, '--out', str(out))
     _, err = proc.communicate(timeout=HANG_BOUND)
