@@ -14,6 +14,7 @@
 
 """The layer rules of ARCHITECTURE.md as import-linter contracts (setup.cfg [importlinter])."""
 
+import logging
 from pathlib import Path
 
 import pytest
@@ -26,4 +27,13 @@ def test_import_contracts_hold(monkeypatch):
     cli = pytest.importorskip('importlinter.cli', reason='import-linter is a test extra')
     monkeypatch.chdir(ROOT)
     monkeypatch.syspath_prepend(str(ROOT))
-    assert cli.lint_imports(config_filename=str(ROOT / 'setup.cfg'), no_cache=True) == 0
+    # lint_imports configures logging with disable_existing_loggers: without this, every
+    # logger made before it stays disabled for the rest of the session (later caplog tests
+    # would see nothing).
+    existing = [logger for logger in logging.root.manager.loggerDict.values()
+                if isinstance(logger, logging.Logger) and not logger.disabled]
+    try:
+        assert cli.lint_imports(config_filename=str(ROOT / 'setup.cfg'), no_cache=True) == 0
+    finally:
+        for logger in existing:
+            logger.disabled = False

@@ -27,8 +27,9 @@ reads and parses the file before it needs the records.
 
 from __future__ import annotations
 
-import importlib
-from typing import Any, TYPE_CHECKING
+from typing import TYPE_CHECKING
+
+from ttb_sim.lazy_face import lazy_face
 
 if TYPE_CHECKING:
     from ttb_sim.config.loader import (apply_overrides, builtin_scenarios, config_dirs,
@@ -48,7 +49,6 @@ _FACE = {
     'ttb_sim.config.schema': ('from_mapping', 'iter_keys', 'key_spec', 'to_plain'),
     'ttb_sim.declarations': ('param', 'Spec'),
 }
-_HOME = {name: module for module, names in _FACE.items() for name in names}
 
 __all__ = ['apply_overrides', 'builtin_scenarios', 'car_layout', 'config_dirs', 'from_mapping',
            'IrregularityConfig', 'iter_keys', 'key_spec', 'load_scenario', 'Observer',
@@ -56,16 +56,4 @@ __all__ = ['apply_overrides', 'builtin_scenarios', 'car_layout', 'config_dirs', 
            'parse_override', 'read_yaml', 'resolve', 'Scenario', 'SolverConfig', 'Spec',
            'to_plain', 'TrainConfig']
 
-
-def __getattr__(name: str) -> Any:
-    """Import a name of the package face from its module on first use."""
-    if name not in _HOME:
-        raise AttributeError(f'module {__name__!r} has no attribute {name!r}')
-    value = getattr(importlib.import_module(_HOME[name]), name)
-    globals()[name] = value
-    return value
-
-
-def __dir__() -> list[str]:
-    """List the module's names with the face's lazily imported ones."""
-    return sorted(set(globals()) | set(__all__))
+__getattr__, __dir__ = lazy_face(__name__, _FACE)

@@ -31,8 +31,9 @@ verb that only reads bags, or refuses its arguments, should not wait for.
 
 from __future__ import annotations
 
-import importlib
-from typing import Any, TYPE_CHECKING
+from typing import TYPE_CHECKING
+
+from ttb_sim.lazy_face import lazy_face
 
 if TYPE_CHECKING:
     from ttb_sim.io.bag import BagRecorder, default_bag_path, STORAGES
@@ -46,22 +47,9 @@ _FACE = {
     'ttb_sim.io.streams': ('load_streams', 'Series', 'Streams'),
     'ttb_sim.io.topics': ('FRAME_ID', 'NAMESPACE', 'PeakTracker', 'Topic', 'topic_table'),
 }
-_HOME = {name: module for module, names in _FACE.items() for name in names}
 
 __all__ = ['bag_topics', 'BagRecorder', 'default_bag_path', 'FRAME_ID', 'load_streams',
            'NAMESPACE', 'PeakTracker', 'read_bag', 'Series', 'STORAGES', 'Streams', 'Topic',
            'topic_table', 'TopicArrays']
 
-
-def __getattr__(name: str) -> Any:
-    """Import a name of the package face from its module on first use."""
-    if name not in _HOME:
-        raise AttributeError(f'module {__name__!r} has no attribute {name!r}')
-    value = getattr(importlib.import_module(_HOME[name]), name)
-    globals()[name] = value
-    return value
-
-
-def __dir__() -> list[str]:
-    """List the module's names with the face's lazily imported ones."""
-    return sorted(set(globals()) | set(__all__))
+__getattr__, __dir__ = lazy_face(__name__, _FACE)

@@ -31,7 +31,7 @@ from ttb_sim.model.structure import Structure
 from ttb_sim.model.vehicle.train import MovingForces
 from ttb_sim.sim.coupling.base import FreeDofState, girder_wheel_load, VehicleOutputs
 from ttb_sim.sim.coupling.girder_load import moving_load, MovingLoad
-from ttb_sim.sim.integrators.newmark_kernels import newmark_ldl_step
+from ttb_sim.sim.integrators.newmark_kernels import largest_magnitude, newmark_ldl_step
 from ttb_sim.sim.integrators.protocol import Integrator
 from ttb_sim.sim.kernel_registry import KernelTable
 
@@ -39,18 +39,6 @@ __all__ = ['advance_moving_forces', 'MovingForceCoupling']
 
 HELPERS = ('moving_load', 'newmark_ldl_step', 'largest_magnitude')
 """Functions the compiled loop calls (:func:`ttb_sim.fe.compiled.jit` compiles them first)."""
-
-
-def largest_magnitude(x: np.ndarray) -> float:
-    """Return max |x| (NaN if any entry is NaN, as ``np.max(np.abs(x))``); 0 for no entries."""
-    peak = 0.0
-    for i in range(x.shape[0]):
-        value = abs(x[i])
-        if value != value:
-            return value
-        if value > peak:
-            peak = value
-    return peak
 
 
 def advance_moving_forces(head: float, speed: float, dt: float, steps: int,
@@ -86,7 +74,7 @@ def advance_moving_forces(head: float, speed: float, dt: float, steps: int,
         moving_load(positions, forces, h, n_el, length, w_dofs, load)
         newmark_ldl_step(indptr, indices, data, lp, li, lx, dinv, order, a0, a1, u, v, a,
                          load[:n], history_buffer, rhs, work)
-        peak = largest_magnitude(u)
+        peak = largest_magnitude(u, 0.0)
         if not peak <= limit:
             return head, step + 1, peak
     return head, steps, peak

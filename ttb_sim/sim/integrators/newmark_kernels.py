@@ -28,7 +28,7 @@ from ttb_sim.fe.bisection import ldl_solve
 from ttb_sim.sim.kernel_registry import KernelTable
 
 HELPERS = ('history', 'effective_load', 'finish_into', 'ldl_solve', 'solve_ldl',
-           'newmark_ldl_step')
+           'newmark_ldl_step', 'largest_magnitude')
 """Functions the kernels call (compiled first, :func:`ttb_sim.fe.compiled.jit`); the compiled
 loops of the couplings call :func:`newmark_ldl_step`."""
 
@@ -74,6 +74,21 @@ def effective_load(indptr: np.ndarray, indices: np.ndarray, data: np.ndarray,
         for p in range(indptr[i], indptr[i + 1]):
             acc += data[p] * history[indices[p]]
         out[i] = force[i] - acc
+
+
+def largest_magnitude(x: np.ndarray, peak: float) -> float:
+    """
+    Return max(peak, max |x|): the divergence check of a compiled loop.
+
+    NaN as soon as an entry is NaN, as ``np.max(np.abs(x))`` gives it.
+    """
+    for i in range(x.shape[0]):
+        value = abs(x[i])
+        if value != value:
+            return value
+        if value > peak:
+            peak = value
+    return peak
 
 
 def solve_ldl(lp: np.ndarray, li: np.ndarray, lx: np.ndarray, dinv: np.ndarray,

@@ -49,12 +49,12 @@ import numpy as np
 
 from ttb_sim.sim.coupling.profile_kernels import quintic
 from ttb_sim.sim.integrators.newmark_kernels import (effective_load, finish_into, history,
-                                                     solve_ldl)
+                                                     largest_magnitude, solve_ldl)
 from ttb_sim.sim.kernel_registry import KernelTable
 
 HELPERS = ('quintic', '_centreline_profile', '_wheel_terms', '_green_correction',
            '_update_cars', 'history', 'effective_load', 'solve_ldl', 'finish_into',
-           '_largest_magnitude')
+           'largest_magnitude')
 """Functions the kernels call: :func:`ttb_sim.fe.compiled.jit` compiles them first."""
 
 
@@ -222,17 +222,6 @@ def _update_cars(u: np.ndarray, dofs: np.ndarray, w: np.ndarray, p: np.ndarray,
         contact[i] = ww + b[i]
 
 
-def _largest_magnitude(x: np.ndarray, peak: float) -> float:
-    """Return max(peak, max |x|), NaN as soon as an entry is NaN (as ``np.max`` gives)."""
-    for i in range(x.shape[0]):
-        value = abs(x[i])
-        if value != value:
-            return value
-        if value > peak:
-            peak = value
-    return peak
-
-
 def _advance_quarter_cars(head: float, speed: float, dt: float, steps: int,
                           offsets: np.ndarray, profile: tuple[Any, ...],
                           girder: tuple[Any, ...], cars: tuple[np.ndarray, ...],
@@ -297,7 +286,7 @@ def _advance_quarter_cars(head: float, speed: float, dt: float, steps: int,
         solve_ldl(lp, li, lx, dinv, order, load, scratch, u)
         _update_cars(u, dofs, w, p, b, e, d, hs_v, hs_a, a0, a1, z, zv, za, contact)
         finish_into(u, a0, a1, h_v, h_a, v, a)
-        peak = _largest_magnitude(z, _largest_magnitude(u, 0.0))
+        peak = largest_magnitude(z, largest_magnitude(u, 0.0))
         if not peak <= limit:
             return head, step + 1, peak
     return head, steps, peak
