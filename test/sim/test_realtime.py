@@ -66,7 +66,8 @@ def same_frames(a: list, b: list) -> None:
 @pytest.mark.parametrize('name', sorted(CASES))
 def test_realtime_writes_the_frames_of_qdldl_bit_for_bit(name):
     sim, fast = run(name, 'realtime', CASES[name])
-    assert sim.coupling.fused(), 'the compiled loop must be the path under test'
+    assert sim.coupling.fused() and sim.compiled_loop, 'the compiled loop must be under test'
+    assert sim.describe()['compiled_loop'] is True
     _, slow = run(name, 'qdldl', CASES[name])
     same_frames(fast, slow)
 
@@ -126,7 +127,7 @@ def test_divergence_stops_at_the_same_step_with_the_same_message(name):
 def test_without_numba_realtime_steps_one_by_one_with_the_same_results(monkeypatch):
     monkeypatch.setattr(kernel_registry, 'ENABLED', False)
     sim, plain = run('moving_force_beam', 'realtime', [])
-    assert not sim.coupling.fused()
+    assert not sim.coupling.fused() and not sim.compiled_loop
     monkeypatch.setattr(kernel_registry, 'ENABLED', True)
     _, fast = run('moving_force_beam', 'realtime', [])
     for a, b in zip(plain, fast):

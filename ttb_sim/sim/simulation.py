@@ -159,6 +159,8 @@ class Simulation:
                                              for p in st.piled))
         self._no_load = np.zeros(0)
         self._state = np.zeros((3, 0))
+        self.compiled_loop = False
+        """True once :meth:`frames` steps in the coupling's compiled loop (``realtime``)."""
         log.info('model: %d free DOFs, %d axles, dt = %.3g s, %d steps', st.n_free,
                  self.vehicle.axles.count, dt, self.n_steps)
 
@@ -232,7 +234,8 @@ class Simulation:
 
     def describe(self) -> dict[str, Any]:
         """Return stepping details for ``summary.json`` (the solver section has the rest)."""
-        about: dict[str, Any] = {'variant': self.scenario.solver.variant}
+        about: dict[str, Any] = {'variant': self.scenario.solver.variant,
+                                 'compiled_loop': self.compiled_loop}
         st = self.structure
         if st.piled:
             solver = self.scenario.solver
@@ -280,6 +283,7 @@ class Simulation:
         cp.start(head)
         loop = (cp if fd is None and self.variant.fused and isinstance(cp, FusedCoupling)
                 and cp.fused() else None)
+        self.compiled_loop = loop is not None
         if loop is not None:   # compile (or load from numba's cache) before the first frame
             loop.advance(head, self.speed, dt, 0, self.scenario.solver.divergence_limit)
         yield self._frame(0, head)
