@@ -88,7 +88,7 @@ class ContactKernels:
     rail_check: Callable[..., Any]
 
     @classmethod
-    def load(cls, irregular: bool = True) -> ContactKernels:
+    def load(cls, irregular: bool = True, single: bool = True) -> ContactKernels:
         """
         Return the kernels compiled, or their plain-Python sources.
 
@@ -96,11 +96,16 @@ class ContactKernels:
         run only where numba is not installed (or is switched off,
         :data:`ttb_sim.sim.kernel_registry.ENABLED`), which is logged. A smooth
         track (``irregular`` False) never samples the irregularity: its kernel
-        is not made, so it is neither compiled nor announced as to compile.
+        is not made, so it is neither compiled nor announced as to compile; nor is
+        the rail predictor of the single-solve step for the two-solve ``reference``
+        (``single`` False).
         """
         names = [f.name for f in fields(cls)]
-        found = [KERNELS.compiled(name) if irregular or name != 'rail_irregularity'
-                 else KERNELS.source(name) for name in names]
+        unused = {'rail_irregularity'} if not irregular else set()
+        if not single:
+            unused.add('rail_predictor')
+        found = [KERNELS.source(name) if name in unused else KERNELS.compiled(name)
+                 for name in names]
         compiled = [kernel for kernel in found if kernel is not None]
         if len(compiled) < len(names):
             log.warning('numba is not available: the multibody contact step runs its '

@@ -121,7 +121,8 @@ class TrainTrackCoupling(FreeDofState):
         self._set_train(train_matrices(car, n_cars, car_length))
         self._set_contact_constants(car, contact)
         self._set_track(structure)
-        self.contact_step = ContactStep(ContactKernels.load(irregular=irregularity is not None))
+        self.contact_step = ContactStep(ContactKernels.load(
+            irregular=irregularity is not None, single=bool(getattr(integrator, 'lean', False))))
         """The compiled step (:mod:`contact_step`), owner of its work arrays."""
         self.influence_hops = INFLUENCE_HOPS if getattr(integrator, 'lean', False) else None
         """Reach of the local K^-1 columns of the single-solve step; None: two solves."""
