@@ -92,7 +92,7 @@ def test_speed_change_applies_at_the_next_frame(beam):
 
 def test_reset_restarts_the_passage_with_continuous_time(beam):
     c = controller(beam)
-    c.advance(budget=5.0, max_frames=200)
+    c.advance(budget=5.0, max_frames=20)   # mid-passage
     before = c.last_frame
     message = c.reset()
     assert 'passage 2' in message
@@ -100,6 +100,24 @@ def test_reset_restarts_the_passage_with_continuous_time(beam):
     assert first.head_position == pytest.approx(beam.train.start_position)
     assert first.time == pytest.approx(before.time + c.frame_period)
     assert first.step == 0
+
+
+@pytest.mark.parametrize('rate', [0.01, 3.0])
+def test_the_next_passage_continues_from_the_simulated_end(beam, rate):
+    # A publishing period longer than the passage (0.01 Hz), or one that does not divide
+    # it (3 Hz): the node's time must follow the simulated time, not the publishing grid.
+    c = controller(beam, loop=True, publish_rate_hz=rate)
+    planned = c.sim.n_steps * c.sim.dt
+    published = []
+    for _ in range(100):
+        tick = c.advance(budget=5.0, max_frames=100)
+        published += tick.frames
+        if c.passage == 2:
+            break
+    assert c.time_offset == pytest.approx(planned + c.sim.dt, rel=1e-12)
+    published += c.advance(budget=5.0, max_frames=1).frames
+    starts = [f.time for f in published if f.step == 0]
+    assert starts[0] == 0.0 and starts[1] == pytest.approx(planned + c.sim.dt, rel=1e-12)
 
 
 def test_pause_stops_stepping_and_resume_continues(beam):

@@ -162,6 +162,8 @@ class PassageController:
         self.passage = 0
         self.time_offset = 0.0
         self.last_frame: Frame | None = None
+        self._ran_out_at: float | None = None
+        """Node time at which the passage's planned steps ran out (None: they have not)."""
         self.sim: Runner
         self._train: TrainRun | None = None   # self.sim when it is a train passage
         self._frames: Iterator[Frame]
@@ -315,6 +317,9 @@ class PassageController:
         try:
             raw = next(self._frames)
         except StopIteration:
+            # The steps after the last frame were simulated too (fewer than a frame
+            # interval; all of the passage when the publishing period exceeds it).
+            self._ran_out_at = self.time_offset + self.sim.n_steps * self.sim.dt
             self._end_passage(tick)
             return
         except DivergenceError as exc:
@@ -394,8 +399,20 @@ class PassageController:
             log.info('passage %d ended; idle (set loop:=true or call ~/reset)', self.passage)
 
     def _restart(self) -> None:
-        if self.last_frame is not None:
+        """
+        Start the next passage, its time continuing the node's.
+
+        After a passage whose planned steps ran out, one step after its last step;
+        otherwise (a reset, or a passage ended at a frame) one frame interval after the
+        latest frame. Before, the first rule was the second's too: with a publishing
+        period that does not divide a passage, the node's time ran ahead of the
+        simulated one by up to a period per passage (one hour at 0.0003 Hz).
+        """
+        if self._ran_out_at is not None:
+            self.time_offset = self._ran_out_at + self.sim.dt
+        elif self.last_frame is not None:
             self.time_offset = self.last_frame.time + self.frame_period
+        self._ran_out_at = None
         self.last_frame = None
         try:
             self._start_passage()
