@@ -73,8 +73,9 @@ from ttb_sim.node import (markers, NodeParameter, PassageController, validate_ch
 from ttb_sim.node.diagnostics import diagnostic_array
 from ttb_sim.node.markers import marker_array
 from ttb_sim.node.message_cache import MessageCache
-from ttb_sim.node.passage import FrameSink, Tick
+from ttb_sim.node.passage import Tick
 from ttb_sim.node.publishing import PublishLoop
+from ttb_sim.node.runs import FrameSink
 from ttb_sim.node.shell import (bag_destination, building_message, ClockGuard,
                                 declare_parameters, live_topics, node_diagnostics, open_bag,
                                 pause_answer, quiet_repeated_warnings, tick_messages)

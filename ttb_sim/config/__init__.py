@@ -34,18 +34,18 @@ from ttb_sim.lazy_face import lazy_face
 if TYPE_CHECKING:
     from ttb_sim.config.loader import (apply_overrides, builtin_scenarios, config_dirs,
                                        load_scenario, parse_override, read_yaml, resolve)
-    from ttb_sim.config.records import (car_layout, IrregularityConfig, Observer,
-                                        OBSERVER_COMPONENTS, OutputConfig, parse_observers,
-                                        Scenario, SolverConfig, TrainConfig)
+    from ttb_sim.config.observers import Observer, OBSERVER_COMPONENTS, parse_observers
+    from ttb_sim.config.records import (car_layout, IrregularityConfig, OutputConfig, Scenario,
+                                        SolverConfig, TrainConfig)
     from ttb_sim.config.schema import from_mapping, iter_keys, key_spec, to_plain
     from ttb_sim.declarations import param, Spec
 
 _FACE = {
     'ttb_sim.config.loader': ('apply_overrides', 'builtin_scenarios', 'config_dirs',
                               'load_scenario', 'parse_override', 'read_yaml', 'resolve'),
-    'ttb_sim.config.records': ('car_layout', 'IrregularityConfig', 'Observer',
-                               'OBSERVER_COMPONENTS', 'OutputConfig', 'parse_observers',
-                               'Scenario', 'SolverConfig', 'TrainConfig'),
+    'ttb_sim.config.observers': ('Observer', 'OBSERVER_COMPONENTS', 'parse_observers'),
+    'ttb_sim.config.records': ('car_layout', 'IrregularityConfig', 'OutputConfig', 'Scenario',
+                               'SolverConfig', 'TrainConfig'),
     'ttb_sim.config.schema': ('from_mapping', 'iter_keys', 'key_spec', 'to_plain'),
     'ttb_sim.declarations': ('param', 'Spec'),
 }

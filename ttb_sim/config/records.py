@@ -33,9 +33,9 @@ import dataclasses
 from dataclasses import dataclass, field
 import functools
 import math
-import re
-from typing import Any, Sequence
+from typing import Any
 
+from ttb_sim.config.observers import Observer, parse_observers
 from ttb_sim.config.schema import to_plain
 from ttb_sim.declarations import param
 from ttb_sim.errors import ScenarioError
@@ -454,50 +454,3 @@ def _check_observers(s: Scenario) -> None:
         if not low <= obs.x <= high:
             raise ScenarioError(f'{where}: x is not on the {obs.component}, which runs from '
                                 f'{low:g} to {high:g} m')
-
-
-OBSERVER_COMPONENTS = ('rail_left', 'rail_right', 'slab', 'base', 'girder')
-_OBSERVER = re.compile(r'^([A-Za-z][A-Za-z0-9_]*)=([a-z_]+)@(.+)$')
-
-
-@dataclass(frozen=True)
-class Observer:
-    """A named displacement observation point (``output.observers``)."""
-
-    name: str
-    component: str
-    x: float
-
-
-def parse_observers(entries: Sequence[str]) -> tuple[Observer, ...]:
-    """
-    Parse ``output.observers`` entries of the form ``name=component@x``.
-
-    Raises
-    ------
-    ScenarioError
-        Naming the entry and what is allowed, for a malformed entry, an unknown
-        component, a non-finite position or a repeated name.
-
-    """
-    out: list[Observer] = []
-    for i, entry in enumerate(entries):
-        path = f'output.observers[{i}] = {shown(entry)}'
-        match = _OBSERVER.match(entry.strip())
-        if not match:
-            raise ScenarioError(f"{path}: expected 'name=component@x' with a name of "
-                                'letters, digits and _ (starting with a letter)')
-        name, component, x_text = match.groups()
-        if component not in OBSERVER_COMPONENTS:
-            raise ScenarioError(f'{path}: component {shown(component)} is unknown; allowed: '
-                                f'{", ".join(OBSERVER_COMPONENTS)}')
-        try:
-            x = float(x_text)
-        except ValueError:
-            x = math.nan
-        if not math.isfinite(x):
-            raise ScenarioError(f'{path}: position {shown(x_text)} is not a finite number (m)')
-        if any(o.name == name for o in out):
-            raise ScenarioError(f'{path}: observer name {shown(name)} is used twice')
-        out.append(Observer(name, component, x))
-    return tuple(out)

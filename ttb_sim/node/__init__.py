@@ -22,7 +22,8 @@ copies values into and out of rclpy objects.
   schema), validation and normalisation of values, start-up values, the
   scenario of a passage;
 - :mod:`~ttb_sim.node.passage`: the :class:`PassageController` that steps,
-  paces, records and reports passages (ticks, frame sink);
+  paces, records and reports passages (ticks);
+- :mod:`~ttb_sim.node.runs`: what it steps and records into (the train run, the frame sink);
 - :mod:`~ttb_sim.node.diagnostics`: what ``/diagnostics`` says, as plain data
   (the report, the stepping meter, the level of a passage state);
 - :mod:`~ttb_sim.node.stepper`: the stepping thread (:class:`Stepper`) that builds
@@ -56,8 +57,9 @@ from ttb_sim.node.parameters import (DEFAULT_SCENARIO, initial_values, IRREGULAR
                                      NodeParameter, normalize_value, parameter_table,
                                      SCENARIO_KEYS, scenario_with, validate_changes,
                                      validate_parameter)
-from ttb_sim.node.passage import FrameSink, PassageController, Tick, TrainRun
+from ttb_sim.node.passage import PassageController, Tick
 from ttb_sim.node.publishing import PublishLoop, PublishStats
+from ttb_sim.node.runs import FrameSink, TrainRun
 from ttb_sim.node.stepper import Stepper, StepperStatus
 
 __all__ = [

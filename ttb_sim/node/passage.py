@@ -19,14 +19,14 @@ Passage control: the simulation stepping behind the live node, paced and recorde
 :class:`PassageController` owns a :class:`~ttb_sim.sim.Runner` (a train
 simulation, or a pile-soil substructure alone under its load),
 steps it paced by the real-time factor, hands every frame to a recorder (a
-:class:`FrameSink`) and the frames due for live publishing (``publish_rate_hz``
-of simulation time) to the caller as a :class:`Tick`, and handles speed
+:class:`~ttb_sim.node.runs.FrameSink`) and the frames due for live publishing
+(``publish_rate_hz`` of simulation time) to the caller as a :class:`Tick`, and handles speed
 changes, reset, pause, loop and divergence. :meth:`PassageController.diagnostics`
 reports solver health as a :class:`~ttb_sim.node.diagnostics.DiagnosticsReport`
 (plain data that the node copies into ``/diagnostics``).
 
-A runner that is a train passage (:class:`TrainRun`: a live speed, an exit position,
-a fundamental frequency) also takes speed changes, computes frames only at the
+A runner that is a train passage (:class:`~ttb_sim.node.runs.TrainRun`: a live speed,
+an exit position, a fundamental frequency) also takes speed changes, computes frames only at the
 publishing rate without a bag, and ends its passage once the train has left; a
 pile-soil substructure run steps its planned time.
 """
@@ -38,14 +38,17 @@ import logging
 import math
 import threading
 import time
-from typing import Any, Callable, Iterator, Mapping, Protocol, runtime_checkable
+from typing import Any, Callable, Iterator, Mapping
 
 from ttb_sim.config import Scenario
 from ttb_sim.errors import DivergenceError, TtbSimError
 from ttb_sim.node.diagnostics import DiagnosticsReport, frame_values, passage_level, StepMeter
 from ttb_sim.node.parameters import (IRREGULARITY_KEYS, normalize_value, parameter_table,
                                      SCENARIO_KEYS, scenario_with)
+from ttb_sim.node.runs import FrameSink, TrainRun
 from ttb_sim.sim import Frame, Layout, make_runner, Runner
+
+__all__ = ['PassageController', 'Tick']
 
 log = logging.getLogger(__name__)
 
@@ -54,46 +57,6 @@ MARKER_PERIOD = 0.1
 
 MAX_LAG = 0.5
 """Wall-clock seconds the stepping may fall behind its pace before the pace is re-anchored."""
-
-
-class _Structure(Protocol):
-    """What passage control reads of a train run's structure."""
-
-    @property
-    def fundamental_frequency(self) -> float:
-        """The first natural frequency of the track-bridge structure (Hz)."""
-
-
-@runtime_checkable
-class TrainRun(Runner, Protocol):
-    """
-    A :class:`~ttb_sim.sim.Runner` of a train passage: what passage control needs beyond it.
-
-    :class:`~ttb_sim.sim.Runner` has none of these (a pile-soil substructure run has no
-    train): a live speed change, the head position at which the train has left the
-    bridge, and the structure's fundamental frequency (the free-vibration tail).
-    """
-
-    @property
-    def structure(self) -> _Structure:
-        """The track-bridge structure."""
-
-    @property
-    def exit_position(self) -> float:
-        """Head position (m) at which the last axle leaves the bridge."""
-
-    def set_speed(self, speed: float) -> None:
-        """Change the train speed (m/s) from the next step on."""
-
-
-class FrameSink(Protocol):
-    """What the controller hands every frame to (a :class:`~ttb_sim.io.bag.BagRecorder`)."""
-
-    def write(self, frame: Frame) -> None:
-        """Record one frame."""
-
-    def close(self) -> None:
-        """Finish recording (idempotent)."""
 
 
 @dataclass
@@ -400,13 +363,11 @@ class PassageController:
 
     def _restart(self) -> None:
         """
-        Start the next passage, its time continuing the node's.
+        Start the next passage, its time continuing the node's from where it stopped.
 
-        After a passage whose planned steps ran out, one step after its last step;
-        otherwise (a reset, or a passage ended at a frame) one frame interval after the
-        latest frame. Before, the first rule was the second's too: with a publishing
-        period that does not divide a passage, the node's time ran ahead of the
-        simulated one by up to a period per passage (one hour at 0.0003 Hz).
+        After a passage whose planned steps ran out, one step after its last step
+        (which may lie past the latest frame); after a reset, or a passage ended at a
+        frame, one frame interval after that frame.
         """
         if self._ran_out_at is not None:
             self.time_offset = self._ran_out_at + self.sim.dt

@@ -39,8 +39,9 @@ from ttb_sim.io.topics import Topic, topic_table
 from ttb_sim.node.diagnostics import DiagnosticsReport, ERROR, OK
 from ttb_sim.node.parameters import (DEFAULT_SCENARIO, initial_values, NodeParameter,
                                      parameter_table)
-from ttb_sim.node.passage import FrameSink, PassageController, Tick
+from ttb_sim.node.passage import PassageController, Tick
 from ttb_sim.node.publishing import PublishStats
+from ttb_sim.node.runs import FrameSink
 from ttb_sim.node.stepper import StepperStatus
 from ttb_sim.sim import Layout, Simulation
 

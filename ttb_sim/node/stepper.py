@@ -20,7 +20,7 @@ own, so that the executor stays free for parameters, services and diagnostics:
 
 1. it builds the :class:`~ttb_sim.node.passage.PassageController` (the model),
    while :meth:`Stepper.status` reports ``building`` with the elapsed time;
-2. it opens the recorder (a :class:`~ttb_sim.node.passage.FrameSink` made by
+2. it opens the recorder (a :class:`~ttb_sim.node.runs.FrameSink` made by
    ``open_recorder``) on this thread, waits until the caller says it is ready
    to publish (:meth:`Stepper.publishing_ready`), then steps, paced by the
    real-time factor, handing each :class:`~ttb_sim.node.passage.Tick` to
@@ -43,7 +43,8 @@ from typing import Any, Callable, Mapping
 from ttb_sim.config import Scenario
 from ttb_sim.errors import TtbSimError
 from ttb_sim.node.parameters import normalize_value, parameter_table
-from ttb_sim.node.passage import FrameSink, PassageController, Tick
+from ttb_sim.node.passage import PassageController, Tick
+from ttb_sim.node.runs import FrameSink
 from ttb_sim.sim import Layout
 
 log = logging.getLogger(__name__)
