@@ -140,7 +140,6 @@ class Simulation:
             self.integrator = Newmark(st.mass, st.damping, st.stiffness, dt,
                                       method=self.variant.factorization,
                                       lean=self.variant.lean,
-                                      split=False if self.variant.fused else None,
                                       fused=self.variant.fused)
             self.coupling = build_coupling(scenario, st, self.vehicle, self.integrator,
                                            self.irregularity, lean=self.variant.lean,

@@ -51,12 +51,15 @@ class Newmark:
         in scipy's order; unsigned indices make it twice as fast as scipy's).
         The lean step also solves a long effective matrix as two halves on two
         threads (``factorize(..., split=True)``; the same to round-off).
+    fused : bool
+        For the couplings' compiled loops (``realtime``, lean only): the effective
+        matrix factorised whole, its QDLDL factors kept for :meth:`fused_arrays`.
 
     """
 
     def __init__(self, mass: sp.spmatrix, damping: sp.spmatrix, stiffness: sp.spmatrix,
                  dt: float, *, method: str = 'superlu', lean: bool = False,
-                 split: bool | None = None, fused: bool = False) -> None:
+                 fused: bool = False) -> None:
         self.dt = float(dt)
         self.a0 = 4.0 / dt**2
         self.a1 = 2.0 / dt
@@ -64,7 +67,7 @@ class Newmark:
         self.damping = sp.csr_matrix(damping)
         self.stiffness = sp.csr_matrix(stiffness)
         effective = (self.stiffness + self.a1 * self.damping + self.a0 * self.mass).tocsc()
-        self._lu = factorize(effective, method=method, split=lean if split is None else split)
+        self._lu = factorize(effective, method=method, split=lean and not fused)
         self.method = self._lu.method
         """The factorisation method in use (after any fallback)."""
         self.lean = lean

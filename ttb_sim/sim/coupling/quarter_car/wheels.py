@@ -268,12 +268,6 @@ class QuarterCarCoupling:
         return u_new, v_new, a_new
 
 
-def _fused_arrays(nm: Integrator) -> tuple[np.ndarray, ...] | None:
-    """Return the integrator's arrays of the compiled loop, or None (see Newmark.fused_arrays)."""
-    fused_arrays = getattr(nm, 'fused_arrays', None)
-    return fused_arrays() if fused_arrays is not None else None
-
-
 class QuarterCarTrain(FreeDofState):
     """
     Quarter cars on the girders as a :class:`~ttb_sim.sim.coupling.base.Coupling`.
@@ -348,7 +342,7 @@ class QuarterCarTrain(FreeDofState):
     def fused(self) -> bool:
         """Tell whether :meth:`advance` runs the compiled loop (else it steps one by one)."""
         if self._fused is None:
-            arrays = _fused_arrays(self.nm)
+            arrays = self.nm.fused_arrays()
             kernel = wheel_kernels.KERNELS.compiled('advance_quarter_cars')
             ok = arrays is not None and kernel is not None and self.kernel.compiled
             self._fused = (kernel, arrays) if ok else ()
