@@ -79,3 +79,27 @@ def test_a_pier_without_both_bearings_has_no_power_flow():
     s = Streams(Path('x'), 'x', pier_top={3: _series(t, np.zeros((t.size, 3)))},
                 bearing={(3, 'left'): _series(t, np.zeros((t.size, 3)))})
     assert pier_power_flows(s) == {}
+
+
+def test_the_ground_grid_map_reads_the_named_points_into_rows_and_columns(tmp_path):
+    """A 2 x 3 grid of pier07 after one line point: x, y axes and RMS az in (row, column)."""
+    from ttb_sim.io.topics import SOIL_FIELDS
+    from ttb_sim.report.figures import soil_grid
+    from ttb_sim.report.metrics import ground_grid_rms
+    t = np.arange(0, 1.0, 0.01)
+    names = ('pier07/line_01', *(f'pier07/grid_{r:02d}_{c:02d}' for r in (1, 2)
+                                 for c in (1, 2, 3)))
+    cloud = np.zeros((t.size, len(names), len(SOIL_FIELDS)))
+    az = SOIL_FIELDS.index('az')
+    for k, (x, y) in enumerate([(0.0, 0.0)] + [(x, y) for y in (-1.0, 1.0)
+                                               for x in (10.0, 11.0, 12.0)]):
+        cloud[:, k, 0], cloud[:, k, 1] = x, y
+        cloud[:, k, az] = (k + 1) * np.sin(2 * np.pi * 5 * t)
+    s = Streams(Path('x'), 'x', soil=_series(t, cloud), soil_fields=SOIL_FIELDS,
+                soil_names=names)
+    (pier, (x, y, rms)), = ground_grid_rms(s).items()
+    assert pier == 'pier07'
+    assert x.tolist() == [10.0, 11.0, 12.0] and y.tolist() == [-1.0, 1.0]
+    np.testing.assert_allclose(rms, np.sqrt(0.5) * np.arange(2, 8).reshape(2, 3), rtol=1e-3)
+    (note,) = soil_grid([s], tmp_path)
+    assert (tmp_path / note.name).stat().st_size > 0

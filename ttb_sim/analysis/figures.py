@@ -220,6 +220,33 @@ def contour_figure(path: Path, title: str, t: np.ndarray, s: np.ndarray, values:
     return path
 
 
+def map_figure(path: Path, title: str,
+               maps: Sequence[tuple[str, np.ndarray, np.ndarray, np.ndarray]],
+               colour_label: str) -> Path:
+    """
+    Write plan maps side by side to a PNG: each (label, x (nx,), y (ny,), values (ny, nx)).
+
+    One colour scale from zero to the largest value over every map (equal axes, m).
+    """
+    fig = Figure(figsize=(4.2 * len(maps) + 1.2, 4.2))
+    fig.subplots_adjust(left=0.07, right=0.9, bottom=0.14, top=0.82, wspace=0.3)
+    fig.suptitle(title, fontsize=11)
+    axes = np.atleast_1d(fig.subplots(1, len(maps)))
+    top = max(float(np.nanmax(v)) for _, _, _, v in maps) or 1.0
+    mesh = None
+    for ax, (label, x, y, values) in zip(axes, maps):
+        mesh = ax.pcolormesh(x, y, values, shading='nearest', cmap='viridis', vmin=0.0,
+                             vmax=top)
+        ax.set_aspect('equal')
+        ax.set_title(label, fontsize=10)
+        ax.set_xlabel('x along the track (m)')
+        ax.set_ylabel('y (m)')
+    bar = fig.colorbar(mesh, ax=list(axes), fraction=0.04)
+    bar.set_label(colour_label)
+    _save(fig, path)
+    return path
+
+
 IndexValue = tuple[str, Optional[float], str]
 """(bag label, value or None where the model cannot produce the index, reason for None)."""
 

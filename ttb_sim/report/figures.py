@@ -30,14 +30,15 @@ from typing import Callable, Sequence
 import numpy as np
 
 from ttb_sim.analysis.excitation import Excitation
-from ttb_sim.analysis.figures import (contour_figure, IndexValue, indices_figure, Panel,
-                                      panels_figure)
+from ttb_sim.analysis.figures import (contour_figure, IndexValue, indices_figure,
+                                      map_figure, Panel, panels_figure)
 from ttb_sim.analysis.levels import vibration_levels
 from ttb_sim.analysis.psd import resolving_segment_seconds, welch_psd
 from ttb_sim.analysis.rigid_displacement import rigid_midspan_displacement
 from ttb_sim.analysis.safety import deck_acceleration
 from ttb_sim.io.streams import Series, Streams
-from ttb_sim.report.metrics import (bag_metrics, CAR_BODY_LOWEST_HZ, marks_of, observer_stations,
+from ttb_sim.report.metrics import (bag_metrics, CAR_BODY_LOWEST_HZ, ground_grid_rms, marks_of,
+                                    observer_stations,
                                     pier_power_flows, power_flows, soil_line,
                                     soil_val_points)
 from ttb_sim.report.output import FigureNote
@@ -255,6 +256,28 @@ def soil_contour(bags: Sequence[Streams], out: Path) -> list[FigureNote]:
     return notes
 
 
+def soil_grid(bags: Sequence[Streams], out: Path) -> list[FigureNote]:
+    """Plan map of the RMS vertical ground acceleration over each piled pier's grid, per bag."""
+    notes = []
+    for s in bags:
+        maps = ground_grid_rms(s)
+        if not maps:
+            continue
+        name = 'soil_grid.png' if len(bags) == 1 else \
+            f'soil_grid_{re.sub(r"[^A-Za-z0-9_.-]", "_", s.label)}.png'
+        map_figure(out / name, f'RMS vertical ground acceleration around the piled piers\n'
+                   f'{s.label}', [(f'{pier} (peak RMS {v.max():.3g} m/s$^2$)', x, y, v)
+                                  for pier, (x, y, v) in maps.items()],
+                   'RMS vertical acceleration (m/s$^2$)')
+        notes.append(FigureNote(name, f'{s.label}: RMS of the vertical ground acceleration over '
+                                'the whole record at each point of the ground grid around each '
+                                'piled pier (output.soil_grid_spacing), in track axes.'))
+    if not notes:
+        raise Skip('no ground grid of soil points (output.soil_grid_spacing, named in '
+                   'summary.json)')
+    return notes
+
+
 def pier_power_flow(bags: Sequence[Streams], out: Path) -> FigureNote:
     """Power flow into each pier through its bearings, piled piers beside piers on springs."""
     flows = [(s, pier_power_flows(s)) for s in bags]
@@ -406,7 +429,7 @@ def indices(bags: Sequence[Streams], out: Path,
 
 FIGURES: tuple[Callable[..., FigureNote | list[FigureNote]], ...] = (
     car_body, wheel_rail, girder, observers, power_flow, piles, rigid, ground, soil_val,
-    soil_contour)
+    soil_contour, soil_grid)
 """Every figure but the indices chart, in the order of index.html."""
 
 

@@ -329,6 +329,31 @@ def soil_line(s: Streams) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
     return order, distance, s.soil.values[:, order, s.soil_fields.index('az')]
 
 
+def ground_grid_rms(s: Streams) -> dict[str, tuple[np.ndarray, np.ndarray, np.ndarray]]:
+    """
+    Return, per piled pier, its ground grid's x (nx,), y (ny,) and RMS az (ny, nx) (m, m/s^2).
+
+    The points named ``pierNN/grid_RR_CC`` in summary.json (rows along y, x fastest);
+    {} without names or grid.
+    """
+    xyz = _soil_xyz(s)
+    if xyz is None or s.soil is None or not s.soil_names:
+        return {}
+    az = s.soil.values[:, :, s.soil_fields.index('az')]
+    rms = np.sqrt(np.mean(az ** 2, axis=0))
+    out: dict[str, tuple[np.ndarray, np.ndarray, np.ndarray]] = {}
+    piers = sorted({n.split('/')[0] for n in s.soil_names if '/grid_' in n})
+    for pier in piers:
+        idx = np.array([i for i, n in enumerate(s.soil_names) if n.startswith(f'{pier}/grid_')])
+        rows = max(int(s.soil_names[i].split('_')[-2]) for i in idx)
+        if idx.size % rows:
+            continue
+        shape = (rows, idx.size // rows)
+        out[pier] = (xyz[idx, 0].reshape(shape)[0], xyz[idx, 1].reshape(shape)[:, 0],
+                     rms[idx].reshape(shape))
+    return out
+
+
 VAL_POINTS_UNNAMED = 6
 """Points rated by VAL in a cloud without names: the first ones after the line."""
 
