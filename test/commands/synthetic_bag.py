@@ -51,7 +51,10 @@ TRACK = {'model': 'slab', 'fastener_vertical_stiffness': 5e7, 'fastener_vertical
          'fastener_spacing': 0.63, 'layer_stiffness': 1.5e9, 'layer_damping': 8.3e4,
          'fasteners_per_slab': 9, 'slab_gap': 0.07}
 LAYOUT = Layout(n_spans=2, n_supports=3, n_bodies=1, n_axles=4,
-                observers=tuple(f'{k}_1' for k in OBS), piles=((1, 3), (2, 3)), soil_points=7)
+                observers=tuple(f'{k}_1' for k in OBS), piles=((1, 3), (2, 3)), soil_points=11)
+SOIL_NAMES = [*(f'pier01/line_{i:02d}' for i in range(1, 6)), 'pier01/val_1', 'pier01/val_2',
+              *(f'pier01/grid_{r:02d}_{c:02d}' for r in (1, 2) for c in (1, 2))]
+"""The cloud's points as summary.json names them: the line, two VAL points, a 2 x 2 grid."""
 
 
 def sine(amplitude: float, frequency: float, t: np.ndarray | float,
@@ -80,10 +83,11 @@ def frame(k: int, scale: float = 1.0) -> Frame:
     pile_a[:, 2] = sine(*PILE_A, t)
     rot = np.zeros((n_piles, 3))
     rot[:, 0] = PILE_ROT[0] * 2 * math.pi * PILE_ROT[1] * math.cos(2 * math.pi * PILE_ROT[1] * t)
-    soil = np.zeros((7, 12))      # a line of five points at y = 3 m, then two VAL points
-    soil[:, 0] = [0.0, 1.0, 2.0, 3.0, 4.0, 1.0, 3.0]
-    soil[:, 1] = [3.0, 3.0, 3.0, 3.0, 3.0, 5.0, 5.0]
-    soil[:, 8] = sine(*SOIL, t) * np.array([1.0, 2.0, 3.0, 4.0, 5.0, 1.0, 5.0])
+    soil = np.zeros((11, 12))     # a line of five points at y = 3 m, two VAL points, a grid
+    soil[:, 0] = [0.0, 1.0, 2.0, 3.0, 4.0, 1.0, 3.0, 10.0, 11.0, 10.0, 11.0]
+    soil[:, 1] = [3.0, 3.0, 3.0, 3.0, 3.0, 5.0, 5.0, -1.0, -1.0, 1.0, 1.0]
+    soil[:, 8] = sine(*SOIL, t) * np.array([1.0, 2.0, 3.0, 4.0, 5.0, 1.0, 5.0, 1.0, 1.0, 1.0,
+                                            1.0])
     return Frame(step=k, time=t, head_position=SPEED * t, speed=SPEED, midspan=mid,
                  bearings=np.zeros((3, 2, 3)), body_acceleration=body,
                  body_angular_velocity=np.zeros((1, 3)), wheel_rail=wheel, observers=obs,
@@ -107,7 +111,8 @@ def write_bag(path: Path, storage: str = 'mcap', scale: float = 1.0,
             'irregularity': {'spectrum': 'paper'},
             'output': {'observers': [f'{k}_1={"rail_left" if k == "rail" else k}@{STATION}'
                                      for k in OBS]}}
-        (path / 'summary.json').write_text(json.dumps({'status': 'ok', 'scenario': scenario}))
+        (path / 'summary.json').write_text(json.dumps({'status': 'ok', 'scenario': scenario,
+                                                       'soil_points': SOIL_NAMES}))
     return path
 
 

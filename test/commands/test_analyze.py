@@ -62,7 +62,7 @@ def test_every_figure_and_the_page(analysed):
     out, metrics = analysed
     expected = {'car_body.png', 'wheel_rail.png', 'girder.png', 'observers.png',
                 'power_flow.png', 'piles.png', 'rigid_displacement.png', 'ground.png',
-                'soil_val.png', 'soil_contour.png', 'indices.png'}
+                'soil_val.png', 'soil_contour.png', 'soil_grid.png', 'indices.png'}
     assert set(metrics['figures']) == expected
     assert metrics['figures_skipped'] == {}
     page = (out / 'index.html').read_text()
@@ -155,7 +155,7 @@ def test_without_summary_figures_needing_it_are_skipped_and_rerun_replaces(tmp_p
     (bag / 'analysis' / 'stale.png').write_bytes(b'x')
     assert main(['analyze', str(bag)]) == 0
     metrics = json.loads((bag / 'analysis' / 'metrics.json').read_text())
-    assert set(metrics['figures_skipped']) == {'observers', 'power_flow'}
+    assert set(metrics['figures_skipped']) == {'observers', 'power_flow', 'soil_grid'}
     assert 'summary.json' in metrics['figures_skipped']['observers']
     assert 'car_body.png' in metrics['figures']
     assert not (bag / 'analysis' / 'stale.png').exists()
