@@ -93,8 +93,9 @@ DEFAULT_WORKLOADS: dict[str, Workload] = {
 }
 """Built-in workloads: the default ``live_coupled`` for 2 s; ``single_pile`` under a 5 Hz
 harmonic head load for 0.2 s (every variant; ``reference`` steps it fully implicit);
-``pile_harmonic`` (752 k DOFs, too large for the implicit ``reference``) for 20 steps with the default variant alone, since every other
-variant runs the same mixed scheme and differs only in the small pile-block factorisation."""
+``pile_harmonic`` (752 k DOFs, too large for the implicit ``reference``) for 20 steps with the
+default variant alone, since every other variant runs the same mixed scheme and differs only
+in the small pile-block factorisation."""
 REFERENCE = 'reference'
 """The variant every other one is compared with."""
 ACCURACY_TARGET = 0.01
