@@ -233,15 +233,15 @@ def map_figure(path: Path, title: str,
     fig.suptitle(title, fontsize=11)
     axes = np.atleast_1d(fig.subplots(1, len(maps)))
     top = max(float(np.nanmax(v)) for _, _, _, v in maps) or 1.0
-    mesh = None
+    meshes = []
     for ax, (label, x, y, values) in zip(axes, maps):
-        mesh = ax.pcolormesh(x, y, values, shading='nearest', cmap='viridis', vmin=0.0,
-                             vmax=top)
+        meshes.append(ax.pcolormesh(x, y, values, shading='nearest', cmap='viridis', vmin=0.0,
+                                    vmax=top))
         ax.set_aspect('equal')
         ax.set_title(label, fontsize=10)
         ax.set_xlabel('x along the track (m)')
         ax.set_ylabel('y (m)')
-    bar = fig.colorbar(mesh, ax=list(axes), fraction=0.04)
+    bar = fig.colorbar(meshes[0], ax=list(axes), fraction=0.04)
     bar.set_label(colour_label)
     _save(fig, path)
     return path
