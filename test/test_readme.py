@@ -27,7 +27,7 @@ import re
 ROOT = Path(__file__).resolve().parents[1]
 README = ROOT / 'README.md'
 MAX_BYTES = 15_000
-RUN = 'python3 -m venv .venv && .venv/bin/pip install . && .venv/bin/ttb-sim run ten_span_train'
+RUN = 'python3 -m venv .venv && .venv/bin/pip install . && .venv/bin/ttb-sim run'
 TEST = ("python3 -m venv .venv && .venv/bin/pip install '.[test]' "
         '&& .venv/bin/python -m pytest test -q')
 VENV = 'python3 -m venv .venv && '

@@ -38,6 +38,7 @@ from typing import Any, NoReturn, Sequence
 
 from ttb_sim import __version__
 from ttb_sim.commands.signals import SignalHandlers, stop_now
+from ttb_sim.config.loader import DEFAULT_SCENARIO
 from ttb_sim.errors import ModelError, ScenarioError, TtbSimError
 
 log = logging.getLogger('ttb_sim')
@@ -73,7 +74,9 @@ def _parser() -> argparse.ArgumentParser:
 def _add_model_verbs(sub: Any) -> None:
     """Add the verbs that build a scenario's model: run, validate, bench, modes."""
     run = sub.add_parser('run', help='simulate a scenario and record a rosbag2')
-    run.add_argument('scenario', help='YAML path or built-in name (see `ttb-sim scenarios`)')
+    run.add_argument('scenario', nargs='?', default=DEFAULT_SCENARIO,
+                     help='YAML path or built-in name (see `ttb-sim scenarios`; default '
+                          f'{DEFAULT_SCENARIO}: the coupled model with piles and soil)')
     # A str, not a Path: Path('') is '.', and an empty --out must be named as empty.
     run.add_argument('--out', help='bag directory to create (default: a new '
                      'folder under ./runs/)')

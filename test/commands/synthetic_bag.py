@@ -80,7 +80,7 @@ def frame(k: int, scale: float = 1.0) -> Frame:
     pile_a[:, 2] = sine(*PILE_A, t)
     rot = np.zeros((n_piles, 3))
     rot[:, 0] = PILE_ROT[0] * 2 * math.pi * PILE_ROT[1] * math.cos(2 * math.pi * PILE_ROT[1] * t)
-    soil = np.zeros((7, 9))       # a line of five points at y = 3 m, then two VAL points
+    soil = np.zeros((7, 12))      # a line of five points at y = 3 m, then two VAL points
     soil[:, 0] = [0.0, 1.0, 2.0, 3.0, 4.0, 1.0, 3.0]
     soil[:, 1] = [3.0, 3.0, 3.0, 3.0, 3.0, 5.0, 5.0]
     soil[:, 8] = sine(*SOIL, t) * np.array([1.0, 2.0, 3.0, 4.0, 5.0, 1.0, 5.0])

@@ -128,7 +128,8 @@ def test_missing_parents_are_made(tmp_path: Path, capsys) -> None:
     assert summary['setup_time'] > 0.0
 
 
-@pytest.mark.parametrize('argv, expected', [(['scenarios'], 0), (['run'], 2)])
+@pytest.mark.parametrize('argv, expected', [(['scenarios'], 0),
+                                            (['run', '/nonexistent.yaml'], 2)])
 def test_the_program_ends_when_its_verb_returns(tmp_path: Path, argv: list[str],
                                                 expected: int) -> None:
     """

@@ -69,8 +69,8 @@ def test_overrides_are_yaml_scalars():
      r'train\.speed_kmh \(its 11 keys: train\.vehicle, '),
     ('soil.mesh={h: 1}', r"soil.mesh = \{'h': 1\}: soil.mesh is a section, not a value; set one "
      r'of its keys, e\.g\. soil\.mesh\.h \(its 6 keys'),
-    ('output=', r"output = '': output is a section, not a value; .* 3 keys: output.rate_hz, "
-     r'output.observers, output.soil_points; see'),
+    ('output=', r"output = '': output is a section, not a value; .* 5 keys: output.rate_hz, "
+     r'output.observers, output.soil_points, output.soil_grid_spacing, \.\.\.; see'),
 ])
 def test_refusals_name_key_value_and_range(override, match):
     with pytest.raises(ScenarioError, match=match):

@@ -45,7 +45,7 @@ def _frame(step: int) -> Frame:
                  pile_displacement=rng.normal(size=(n, 3)) * 1e-3,
                  pile_acceleration=rng.normal(size=(n, 3)),
                  pile_rotation_rate=rng.normal(size=(n, 3)) * 1e-2,
-                 soil_points=rng.normal(size=(LAYOUT.soil_points, 9)))
+                 soil_points=rng.normal(size=(LAYOUT.soil_points, len(SOIL_FIELDS))))
 
 
 def test_topic_names_follow_the_contract():
@@ -71,10 +71,14 @@ def test_pile_and_soil_messages_round_trip(tmp_path, storage):
                   if c.topic == '/ttb_sim/soil/points']
     assert len(clouds) == 3
     cloud = clouds[1]
-    assert (cloud.height, cloud.width, cloud.point_step) == (1, 4, 36)
+    assert (cloud.height, cloud.width, cloud.point_step) == (1, 4, 48)
     assert [f.name for f in cloud.fields] == list(SOIL_FIELDS)
+    # the contract's nine fields first, at their offsets; the velocities after them
+    assert [(f.name, f.offset) for f in cloud.fields[:9]] == [
+        (name, 4 * i) for i, name in enumerate(('x', 'y', 'z', 'ux', 'uy', 'uz', 'ax', 'ay',
+                                                'az'))]
     assert {f.datatype for f in cloud.fields} == {7} and not cloud.is_bigendian
-    points = np.frombuffer(cloud.data.tobytes(), dtype='<f4').reshape(4, 9)
+    points = np.frombuffer(cloud.data.tobytes(), dtype='<f4').reshape(4, 12)
     np.testing.assert_array_equal(points, frames[1].soil_points.astype(np.float32))
     arrays = read_bag(tmp_path / 'bag')
     disp = arrays['/ttb_sim/piles/pier08/pile02/displacement']['vector']
@@ -100,7 +104,7 @@ def test_mcap_reader_decodes_the_cloud_independently(tmp_path):
         msgs = [m for _, ch, _, m in reader.iter_decoded_messages()
                 if ch.topic == '/ttb_sim/soil/points']
     assert len(msgs) == 1
-    points = np.frombuffer(bytes(msgs[0].data), dtype='<f4').reshape(-1, 9)
+    points = np.frombuffer(bytes(msgs[0].data), dtype='<f4').reshape(-1, 12)
     np.testing.assert_array_equal(points, frame.soil_points.astype(np.float32))
 
 
@@ -115,6 +119,6 @@ def test_rclpy_style_classes_get_an_array_of_bytes():
         make.__module__ = name.replace('/', '.')
         return make
 
-    build_point_cloud(fake, 0, np.arange(18, dtype=float))
+    build_point_cloud(fake, 0, np.arange(24, dtype=float))
     data = made['sensor_msgs/msg/PointCloud2']['data']
-    assert isinstance(data, array.array) and data.typecode == 'B' and len(data) == 72
+    assert isinstance(data, array.array) and data.typecode == 'B' and len(data) == 96

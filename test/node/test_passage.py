@@ -22,7 +22,7 @@ import pytest
 from rosbags.highlevel import AnyReader
 from ttb_sim.config import load_scenario, Scenario
 from ttb_sim.io.bag import BagRecorder
-from ttb_sim.io.topics import topic_table
+from ttb_sim.io.topics import SOIL_FIELDS, topic_table
 from ttb_sim.node.diagnostics import ERROR, OK
 from ttb_sim.node.parameters import initial_values, parameter_table
 from ttb_sim.node.passage import PassageController
@@ -335,7 +335,7 @@ def test_a_substructure_scenario_streams_its_piles_and_soil_points(tmp_path: Pat
     assert c.state == 'idle' and len(recorder.frames) == 21 == len(published)
     assert recorder.frames[-1].time == pytest.approx(0.2)
     assert abs(recorder.frames[-1].pile_displacement[0, 2]) > 0
-    assert recorder.frames[-1].soil_points.shape[1] == 9
+    assert recorder.frames[-1].soil_points.shape[1] == len(SOIL_FIELDS)
 
 
 def test_the_pace_runs_on_across_loop_restarts(beam):

@@ -102,3 +102,30 @@ def test_bounce_frequency_from_free_vibration():
     # the released state at t = 0 was set by hand, its contact is not computed).
     balance = contact[1:] - MS * acc[1:]
     assert balance == pytest.approx(np.full(n_steps, WEIGHT), rel=1e-3)
+
+
+def test_the_quarter_cars_of_a_car_layout_are_published_as_cars_with_their_axles():
+    """live_train's 4 cars of 4 quarter cars: car01..car04, axle1..4; body = mean of four."""
+    from ttb_sim.config import load_scenario
+    from ttb_sim.sim import Simulation
+    sim = Simulation(load_scenario('live_train', values=[('solver.duration', 0.05),
+                                                         ('irregularity.seed', 2)]))
+    frames = list(sim.frames())
+    cp = sim.coupling
+    assert (sim.layout.n_bodies, sim.layout.n_axles) == (4, 4)
+    last = frames[-1]
+    assert last.wheel_rail.shape == (4, 4, 2, 3)
+    np.testing.assert_array_equal(last.wheel_rail[..., 2].ravel(),
+                                  np.repeat(0.5 * cp.kernel.contact, 2))
+    np.testing.assert_allclose(last.body_acceleration[:, 2],
+                               cp.kernel.a.reshape(4, 4).mean(axis=1), rtol=1e-15)
+    assert np.all(last.body_angular_velocity == 0.0)
+
+
+def test_axles_placed_by_hand_are_one_car_each():
+    """sprung_mass_beam (axle_offsets [0]): car01 with axle1, as the contract names them."""
+    from ttb_sim.config import load_scenario
+    from ttb_sim.sim import Simulation
+    sim = Simulation(load_scenario('sprung_mass_beam', values=[
+        ('train.axle_offsets', [0.0, 3.0, 6.0])]))
+    assert (sim.layout.n_bodies, sim.layout.n_axles) == (3, 1)

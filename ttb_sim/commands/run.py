@@ -177,6 +177,7 @@ def _summary(scenario: Scenario, sim: Runner, out: Path, storage: str, topics: S
         'wall_time': wall,
         'real_time_factor': done.last_time / wall if wall > 0 else None,
         'peaks': peaks.summary(),
+        'soil_points': list(sim.layout.soil_point_names),
     }
 
 

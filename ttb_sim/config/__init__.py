@@ -33,7 +33,8 @@ from ttb_sim.lazy_face import lazy_face
 
 if TYPE_CHECKING:
     from ttb_sim.config.loader import (apply_overrides, builtin_scenarios, config_dirs,
-                                       load_scenario, parse_override, read_yaml, resolve)
+                                       DEFAULT_SCENARIO, load_scenario, parse_override,
+                                       read_yaml, resolve)
     from ttb_sim.config.observers import Observer, OBSERVER_COMPONENTS, parse_observers
     from ttb_sim.config.records import (car_layout, IrregularityConfig, OutputConfig, Scenario,
                                         SolverConfig, TrainConfig)
@@ -42,7 +43,8 @@ if TYPE_CHECKING:
 
 _FACE = {
     'ttb_sim.config.loader': ('apply_overrides', 'builtin_scenarios', 'config_dirs',
-                              'load_scenario', 'parse_override', 'read_yaml', 'resolve'),
+                              'DEFAULT_SCENARIO', 'load_scenario', 'parse_override',
+                              'read_yaml', 'resolve'),
     'ttb_sim.config.observers': ('Observer', 'OBSERVER_COMPONENTS', 'parse_observers'),
     'ttb_sim.config.records': ('car_layout', 'IrregularityConfig', 'OutputConfig', 'Scenario',
                                'SolverConfig', 'TrainConfig'),
@@ -50,7 +52,8 @@ _FACE = {
     'ttb_sim.declarations': ('param', 'Spec'),
 }
 
-__all__ = ['apply_overrides', 'builtin_scenarios', 'car_layout', 'config_dirs', 'from_mapping',
+__all__ = ['apply_overrides', 'builtin_scenarios', 'car_layout', 'config_dirs',
+           'DEFAULT_SCENARIO', 'from_mapping',
            'IrregularityConfig', 'iter_keys', 'key_spec', 'load_scenario', 'Observer',
            'OBSERVER_COMPONENTS', 'OutputConfig', 'param', 'parse_observers',
            'parse_override', 'read_yaml', 'resolve', 'Scenario', 'SolverConfig', 'Spec',

@@ -31,6 +31,8 @@ import yaml
 if TYPE_CHECKING:
     from ttb_sim.config.records import Scenario  # loaded by from_mapping once the file is read
 
+DEFAULT_SCENARIO = 'live_coupled'
+"""The built-in scenario of ``ttb-sim run`` without one and of the node without a ``scenario``."""
 MAX_SCENARIO_BYTES = 1 << 20
 """Largest scenario file read (bytes): built-ins are about 2 kB."""
 MAX_YAML_DEPTH = 32

@@ -180,6 +180,12 @@ class OutputConfig:
         (), 'm', 'Ground observation points [x, y, z] of a pile-soil substructure, besides '
         "[P]'s observation line and VAL points (published on ~/soil/points).", low=-1e4,
         high=1e4)
+    soil_grid_spacing: float = param(
+        0.0, 'm', 'Spacing of a ground-surface grid of soil points over the cap of each piled '
+        'pier (its pile group without a cap) plus output.soil_grid_margin (published on '
+        '~/soil/points with the other points); 0 = no grid.', low=0.0, high=100.0)
+    soil_grid_margin: float = param(3.0, 'm', 'Margin of the soil grid beyond the cap on '
+                                    'every side.', low=0.0, high=1000.0)
 
     @functools.cached_property
     def points(self) -> tuple[Observer, ...]:
@@ -223,7 +229,10 @@ class Scenario:
         """Return the pile-soil substructure the soil, piles, cap and interface keys describe."""
         return Substructure(name=name, soil=self.soil, piles=self.piles, cap=self.cap,
                             interface=self.interface,
-                            observation=Observation(points=self.output.soil_points))
+                            observation=Observation(
+                                points=self.output.soil_points,
+                                grid_spacing=self.output.soil_grid_spacing,
+                                grid_margin=self.output.soil_grid_margin))
 
     def axle_positions(self) -> tuple[float, ...]:
         """Distances of all axles behind the head (m): ``train.axle_offsets`` or the car layout."""

@@ -51,6 +51,7 @@ _PATTERNS = {
     'pile_displacement': re.compile(r'/piles/pier(\d+)/pile(\d+)/displacement$'),
     'pile_imu': re.compile(r'/piles/pier(\d+)/pile(\d+)/imu$'),
     'soil': re.compile(r'/soil/points$'),
+    'pier_top': re.compile(r'/piers/pier(\d+)/top$'),
     'observer': re.compile(r'/observers/([^/]+)$'),
     'odometry': re.compile(r'/train/odometry$'),
 }
@@ -87,7 +88,10 @@ class Streams:
     pile_rotation_rate: dict[tuple[int, int], Series] = field(default_factory=dict)
     soil: Series | None = None
     soil_fields: tuple[str, ...] = ()
+    soil_names: tuple[str, ...] = ()
+    """Names of the cloud's points (``pierNN/line_01`` ...) from summary.json; () without."""
     observers: dict[str, Series] = field(default_factory=dict)
+    pier_top: dict[int, Series] = field(default_factory=dict)
 
     @property
     def duration(self) -> float:
@@ -202,6 +206,12 @@ def load_streams(path: str | Path, label: str | None = None) -> Streams:
             out.soil_fields = a.components['points']
         elif kind == 'observer':
             _put(out.observers, groups[0], a, a['vector'])
+        elif kind == 'pier_top':
+            _put(out.pier_top, int(groups[0]), a, a['vector'])
+    names = summary.get('soil_points') if summary else None
+    if (out.soil is not None and isinstance(names, list)
+            and len(names) == out.soil.values.shape[1]):
+        out.soil_names = tuple(str(n) for n in names)
     if speeds:
         out.speed = speeds[0]
     elif scenario and isinstance(scenario.get('train'), dict):

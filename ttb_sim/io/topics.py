@@ -107,17 +107,23 @@ def build_odometry(types: MessageTypes, stamp_ns: int, values: np.ndarray) -> An
                                           twist=twist_cov)
 
 
-SOIL_FIELDS = ('x', 'y', 'z', 'ux', 'uy', 'uz', 'ax', 'ay', 'az')
-"""Float32 fields of every ground point in ``~/soil/points``, in this order."""
+SOIL_FIELDS = ('x', 'y', 'z', 'ux', 'uy', 'uz', 'ax', 'ay', 'az', 'vx', 'vy', 'vz')
+"""
+Float32 fields of every ground point in ``~/soil/points``, in this order.
+
+Position (m), displacement (m), acceleration (m/s^2), then velocity (m/s): the
+velocity comes last so that the first nine fields keep the offsets readers of
+the earlier nine-field clouds use.
+"""
 _FLOAT32 = 7  # sensor_msgs/msg/PointField.FLOAT32
 
 
 def build_point_cloud(types: MessageTypes, stamp_ns: int, values: np.ndarray) -> Any:
     """
-    Build ``sensor_msgs/msg/PointCloud2`` of ground points from flattened (n, 9) values.
+    Build ``sensor_msgs/msg/PointCloud2`` of ground points from flattened (n, 12) values.
 
     One row of n points (``height`` 1), little-endian float32 fields
-    :data:`SOIL_FIELDS`, 36 bytes per point, dense.
+    :data:`SOIL_FIELDS`, 48 bytes per point, dense.
     """
     points = np.ascontiguousarray(np.asarray(values, dtype='<f4').reshape(-1, len(SOIL_FIELDS)))
     field_type = types('sensor_msgs/msg/PointField')
@@ -245,6 +251,10 @@ def topic_table(layout: Layout) -> list[Topic]:
                 f'bearings/pier{s + 1:02d}/{side}', 'geometry_msgs/msg/WrenchStamped', WRENCH,
                 _columns(col['bearings'][s, side_index], pad3), build_wrench_stamped,
                 unit='N'))
+    for j, pier in enumerate(layout.piers):
+        topics.append(Topic(f'piers/pier{pier:02d}/top', 'geometry_msgs/msg/Vector3Stamped',
+                            VECTOR3, _columns(col['pier_tops'][j]), build_vector3_stamped,
+                            unit='m'))
     index = 0
     for pier, n_piles in layout.piles:
         for m in range(n_piles):
@@ -260,7 +270,7 @@ def topic_table(layout: Layout) -> list[Topic]:
     if layout.soil_points:
         topics.append(Topic('soil/points', 'sensor_msgs/msg/PointCloud2', (),
                             _columns(col['soil_points']), build_point_cloud,
-                            unit='m, m, m/s^2'))
+                            unit='m, m, m/s^2, m/s'))
     for j, name in enumerate(layout.observers):
         topics.append(Topic(f'observers/{name}', 'geometry_msgs/msg/Vector3Stamped', VECTOR3,
                             _columns(col['observers'][j]), build_vector3_stamped, unit='m'))

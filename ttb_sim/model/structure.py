@@ -30,7 +30,7 @@ bridge, as a monitoring system zeroed before the passage would measure them.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Mapping
 
 import numpy as np
@@ -107,6 +107,11 @@ class Structure:
     """The slab track (full DOF numbering), if modelled."""
     piled: tuple[PiledPier, ...] = ()
     """The piled piers, by support."""
+    pier_supports: tuple[int, ...] = ()
+    """Supports (0-based) that stand on a pier column, in order (abutments have none)."""
+    pier_top_dofs: np.ndarray = field(default_factory=lambda: np.zeros((0, 3), dtype=np.intp))
+    """(len(pier_supports), 3) extended free indices of ux, uy, uz at each pier top; the
+    zero slot where the top is not a structure DOF (partitioned piled piers)."""
 
     @property
     def n_free(self) -> int:
@@ -338,6 +343,13 @@ def assemble_structure(b: BridgeParameters, br: BearingParameters, pr: PierParam
     bearings = (links_elastic.numbered(full_to_free, dof_map.n_free)
                 if links_elastic is not None else None)
     mid = beams.girder_nodes[:, b.elements_per_span // 2]
+    pier_supports = tuple(int(k) for k in np.flatnonzero((blocks.pier_top >= 0)
+                                                         | np.isin(np.arange(b.n_spans + 1),
+                                                                   piled)))
+    tops = blocks.pier_top[list(pier_supports)]
+    top_dofs = np.where(tops[:, None] >= 0,
+                        full_to_free[np.maximum(tops, 0)[:, None] * NODE_DOFS + np.arange(3)],
+                        dof_map.n_free)
     return Structure(mass=_reduce(m_full, free), damping=_reduce(c_full, free),
                      stiffness=_reduce(k_full, free), dofs=dof_map,
                      girder=girder_line(b, beams.girders.elements, full_to_free),
@@ -345,7 +357,8 @@ def assemble_structure(b: BridgeParameters, br: BearingParameters, pr: PierParam
                      bearings=bearings, rigid=rigid, n_supports=b.n_spans + 1,
                      bearing_spacing=br.spacing, fundamental_frequency=f1, rayleigh=rayleigh,
                      girder_beam=beams.girder_beam, track=beams.track,
-                     piled=_piled_piers(foundations, piled, blocks, bearings, full_to_free))
+                     piled=_piled_piers(foundations, piled, blocks, bearings, full_to_free),
+                     pier_supports=pier_supports, pier_top_dofs=top_dofs.reshape(-1, 3))
 
 
 def _reduce(a: sp.csr_matrix, free: np.ndarray) -> sp.csr_matrix:

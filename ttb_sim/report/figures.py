@@ -38,7 +38,8 @@ from ttb_sim.analysis.rigid_displacement import rigid_midspan_displacement
 from ttb_sim.analysis.safety import deck_acceleration
 from ttb_sim.io.streams import Series, Streams
 from ttb_sim.report.metrics import (bag_metrics, CAR_BODY_LOWEST_HZ, marks_of, observer_stations,
-                                    power_flows, soil_line, soil_val_points)
+                                    pier_power_flows, power_flows, soil_line,
+                                    soil_val_points)
 from ttb_sim.report.output import FigureNote
 
 log = logging.getLogger(__name__)
@@ -254,13 +255,48 @@ def soil_contour(bags: Sequence[Streams], out: Path) -> list[FigureNote]:
     return notes
 
 
+def pier_power_flow(bags: Sequence[Streams], out: Path) -> FigureNote:
+    """Power flow into each pier through its bearings, piled piers beside piers on springs."""
+    flows = [(s, pier_power_flows(s)) for s in bags]
+    flows = [(s, f) for s, f in flows if f]
+    if not flows:
+        raise Skip('needs observers of rail, slab, base and girder at one x (output.observers) '
+                   'on a slab track and summary.json, or pier tops (piers/pierNN/top) with '
+                   'their bearings')
+    marks = _marks(bags)
+    panels = []
+    for pier in sorted(set().union(*(f for _, f in flows))):
+        piled = any(pier in _piled(s) for s, _ in flows)
+        traces, total = [], []
+        for s, f in flows:
+            if pier in f:
+                freq, p = f[pier]
+                traces.append((s.label, freq[1:], np.abs(p[1:])))
+                total.append(f'{p.sum():.3g}')
+        panels.append(Panel(f'pier{pier:02d} ({"piled" if piled else "springs"}): mean '
+                            f'{" / ".join(total)} W', 'frequency f (Hz)', '|P(f)| per line (W)',
+                            traces, logy=True, xlim=(0.0, 50.0), marks=marks))
+    rows = [panels[i:i + 3] for i in range(0, len(panels), 3)]
+    path = panels_figure(out / 'power_flow.png', 'Vibration power flow into the piers through '
+                         'their bearings ([P] Eqs. 17-18)', rows)
+    return FigureNote(path.name, 'Power flow P(f) = 1/2 Re[F V*] per FFT line into each pier: the '
+                      "force of its two bearings against its top's velocity (W), piled piers "
+                      'and piers on foundation springs side by side (the rocking power of the '
+                      'bearing pair is not recorded). Magnitudes on a log axis; the titles give '
+                      'the time-mean power (the sum of the lines).')
+
+
+def _piled(s: Streams) -> set[int]:
+    """Return the piled piers of a bag (from its pile topics)."""
+    return {pier for pier, _ in s.pile_displacement} | {pier for pier, _ in s.pile_acceleration}
+
+
 def power_flow(bags: Sequence[Streams], out: Path) -> FigureNote:
     """Power flow per layer (rail, slab, base, girder) at each observer station."""
     flows = [(s, power_flows(s)) for s in bags]
     flows = [(s, f) for s, f in flows if f]
     if not flows:
-        raise Skip('needs observers of rail, slab, base and girder at one x (output.observers) '
-                   'on a slab track, and summary.json for the layer properties')
+        return pier_power_flow(bags, out)
     marks = _marks(bags)
     stations = sorted(set().union(*(f for _, f in flows)))
     panels = []

@@ -214,6 +214,10 @@ def bag_metrics(s: Streams) -> dict[str, Any]:
         out['power_flow_mean_W_per_m'] = {
             station: {layer: float(np.sum(p)) for layer, (_, p) in layers.items()}
             for station, layers in flows.items()}
+    into_piers = pier_power_flows(s)
+    if into_piers:
+        out['power_into_piers'] = {f'pier{p:02d}': _pier_power_metrics(f, pw)
+                                   for p, (f, pw) in into_piers.items()}
     out['indices'] = indices
     return out
 
@@ -303,33 +307,52 @@ def soil_line(s: Streams) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
     """
     Return (point indices, distance along the line (m), az (n, points)) of the observation line.
 
-    The line is the points at the first point's y and z (to 1 mm), ordered by x:
-    ttb_sim writes [P]'s observation line first, then the VAL points and the
-    user's points elsewhere.
+    The first piled pier's ``line_`` points where summary.json names the points;
+    else the points from the first one on that share its y and z (to 1 mm), in
+    the order written: ttb_sim writes [P]'s observation line first, then the VAL
+    points, the user's points and the ground grid. Ordered by x.
     """
     xyz = _soil_xyz(s)
     if xyz is None or s.soil is None:
         return None
-    on = np.flatnonzero((np.abs(xyz[:, 1] - xyz[0, 1]) < 1e-3)
-                        & (np.abs(xyz[:, 2] - xyz[0, 2]) < 1e-3))
+    if s.soil_names:
+        first = s.soil_names[0].split('/')[0]
+        on = np.array([i for i, n in enumerate(s.soil_names)
+                       if n.startswith(f'{first}/line_')], dtype=np.intp)
+    else:
+        same = ((np.abs(xyz[:, 1] - xyz[0, 1]) < 1e-3) & (np.abs(xyz[:, 2] - xyz[0, 2]) < 1e-3))
+        on = np.arange(int(np.argmin(same)) if not same.all() else same.size)
+    if on.size == 0:
+        on = np.arange(1)
     order = on[np.argsort(xyz[on, 0], kind='stable')]
     distance = xyz[order, 0] - xyz[order[0], 0]
     return order, distance, s.soil.values[:, order, s.soil_fields.index('az')]
+
+
+VAL_POINTS_UNNAMED = 6
+"""Points rated by VAL in a cloud without names: the first ones after the line."""
 
 
 def soil_val_points(s: Streams) -> list[tuple[str, np.ndarray]]:
     """
     Return (label, vertical acceleration record) of the ground points to rate by VAL.
 
-    The points off the observation line (ttb_sim's [P] section 4.2.2 VAL points and the
-    user's points) when there are any, else the first, middle and last point of the line.
+    Where summary.json names the points: every pier's [P] section 4.2.2 VAL
+    points and the user's points (not the ground grid). Without names: the
+    first :data:`VAL_POINTS_UNNAMED` points after the observation line. Where
+    there are none, the first, middle and last point of the line.
     """
     xyz = _soil_xyz(s)
     line = soil_line(s)
     if xyz is None or line is None or s.soil is None:
         return []
     az = s.soil.values[:, :, s.soil_fields.index('az')]
-    off = [i for i in range(xyz.shape[0]) if i not in set(line[0].tolist())]
+    on_line = set(line[0].tolist())
+    if s.soil_names:
+        off = [i for i, n in enumerate(s.soil_names)
+               if n.split('/')[-1].startswith(('val_', 'user_'))]
+    else:
+        off = [i for i in range(xyz.shape[0]) if i not in on_line][:VAL_POINTS_UNNAMED]
     if off:
         return [(f'point ({xyz[i, 0]:.1f}, {xyz[i, 1]:.1f}) m', az[:, i]) for i in off]
     order, distance, _ = line
@@ -409,6 +432,37 @@ def power_flows(s: Streams) -> dict[str, dict[str, tuple[np.ndarray, np.ndarray]
             'base': power_flow_spectrum(q_ca, v['base'], fs),
             'girder': power_flow_spectrum(q_bg, v['girder'], fs)}
     return out
+
+
+def pier_power_flows(s: Streams) -> dict[int, tuple[np.ndarray, np.ndarray]]:
+    """
+    Return the power flow spectrum into each pier through its bearings (W), by pier number.
+
+    Eq. 18 with the force the two bearings put on the pier top (their sum, x,
+    y, z) against the pier top's velocity (differentiated from its recorded
+    displacement): the vibration power the girders pass into the pier, its
+    foundation and the ground. The pier top's rotation is not recorded, so the
+    power of the bearing pair's moment (their force difference times half
+    their spacing, against the rocking rate) is left out: zero where the load
+    is symmetric about the centreline (quarter cars, moving forces).
+    """
+    out: dict[int, tuple[np.ndarray, np.ndarray]] = {}
+    for pier, top in sorted(s.pier_top.items()):
+        left, right = s.bearing.get((pier, 'left')), s.bearing.get((pier, 'right'))
+        if left is None or right is None:
+            continue
+        n = min(top.t.size, left.t.size, right.t.size)
+        force = left.values[:n] + right.values[:n]
+        velocity = np.column_stack([velocity_from_displacement(top.values[:n, c], top.rate)
+                                    for c in range(3)])
+        spectra = [power_flow_spectrum(force[:, c], velocity[:, c], top.rate) for c in range(3)]
+        out[pier] = (spectra[0][0], spectra[0][1] + spectra[1][1] + spectra[2][1])
+    return out
+
+
+def _pier_power_metrics(f: np.ndarray, p: np.ndarray) -> dict[str, float]:
+    """Return the mean power into a pier, in total and at 0-1 Hz ([P] Figs. 18-19's band)."""
+    return {'mean_W': float(np.sum(p)), 'mean_0_1_Hz_W': float(np.sum(p[f <= 1.0]))}
 
 
 # -- comparing bags ----------------------------------------------------------------------

@@ -118,10 +118,12 @@ def build_vehicle(scenario: Scenario) -> Vehicle:
                              n_cars=train.n_cars, car_length=train.car_length)
     if train.vehicle == 'moving_force':
         return MovingForces(axles=axles, loads=np.full(n, train.axle_load))
+    # axles of the car layout are published per car; axles placed by hand one per car
+    per_car = n // train.n_cars if not train.axle_offsets and n % train.n_cars == 0 else 1
     return QuarterCars(axles=axles, sprung_mass=np.full(n, train.sprung_mass),
                        unsprung_mass=np.full(n, train.unsprung_mass),
                        stiffness=np.full(n, train.suspension_stiffness),
-                       damping=np.full(n, train.suspension_damping))
+                       damping=np.full(n, train.suspension_damping), axles_per_car=per_car)
 
 
 CONTACT_STEP = 1e-4

@@ -31,8 +31,10 @@ import numpy as np
 
 ROW_FIELDS = ('head_position', 'speed', 'midspan', 'bearings', 'body_acceleration',
               'body_angular_velocity', 'wheel_rail', 'observers', 'pile_displacement',
-              'pile_acceleration', 'pile_rotation_rate', 'soil_points')
+              'pile_acceleration', 'pile_rotation_rate', 'soil_points', 'pier_tops')
 """The fields of a :class:`Frame` in the order of :attr:`Frame.row` (after its leading zero)."""
+SOIL_VALUES = 12
+"""Values per ground point: x, y, z, displacement, acceleration (the contract's nine), velocity."""
 ZERO_COLUMN = 0
 """The column of :attr:`Frame.row` that always holds 0.0 (for values a topic pads with)."""
 
@@ -55,6 +57,11 @@ class Layout:
     """Number of ground observation points (all piled piers together)."""
     train: bool = True
     """Whether a train runs (False for a substructure alone: no odometry)."""
+    piers: tuple[int, ...] = ()
+    """Pier numbers (1-based supports) whose top displacement is reported, in frame order."""
+    soil_point_names: tuple[str, ...] = ()
+    """Name of each ground point in frame order, ``pierNN/<name>`` (``line_01``, ``val_1``,
+    ``user_01``, ``grid_RR_CC``): written to ``summary.json`` so analysis can tell them apart."""
 
     @property
     def n_piles(self) -> int:
@@ -70,7 +77,8 @@ class Layout:
                 'wheel_rail': (self.n_bodies, self.n_axles, 2, 3),
                 'observers': (len(self.observers), 3), 'pile_displacement': piles,
                 'pile_acceleration': piles, 'pile_rotation_rate': piles,
-                'soil_points': (self.soil_points, 9)}
+                'soil_points': (self.soil_points, SOIL_VALUES),
+                'pier_tops': (len(self.piers), 3)}
 
     @property
     def row_width(self) -> int:
@@ -134,8 +142,10 @@ class Frame:
         head (m), piles in :attr:`Layout.piles` order
     pile_acceleration : (n_piles, 3) pile-head acceleration (m/s^2)
     pile_rotation_rate : (n_piles, 3) pile-head rotation rate (rad/s)
-    soil_points : (n_points, 9) ground points: x, y, z (m), displacement (m) and
-        acceleration (m/s^2)
+    soil_points : (n_points, 12) ground points: x, y, z (m), displacement (m),
+        acceleration (m/s^2), velocity (m/s)
+    pier_tops : (n_piers, 3) displacement of each pier top, the bearing seat (m), piers
+        in :attr:`Layout.piers` order
 
     """
 
@@ -152,7 +162,8 @@ class Frame:
     pile_displacement: np.ndarray = field(default_factory=lambda: np.zeros((0, 3)))
     pile_acceleration: np.ndarray = field(default_factory=lambda: np.zeros((0, 3)))
     pile_rotation_rate: np.ndarray = field(default_factory=lambda: np.zeros((0, 3)))
-    soil_points: np.ndarray = field(default_factory=lambda: np.zeros((0, 9)))
+    soil_points: np.ndarray = field(default_factory=lambda: np.zeros((0, SOIL_VALUES)))
+    pier_tops: np.ndarray = field(default_factory=lambda: np.zeros((0, 3)))
 
     @cached_property
     def row(self) -> np.ndarray:
@@ -166,7 +177,8 @@ class Frame:
             ((0.0, self.head_position, self.speed), self.midspan, self.bearings,
              self.body_acceleration, self.body_angular_velocity, self.wheel_rail,
              self.observers, self.pile_displacement, self.pile_acceleration,
-             self.pile_rotation_rate, self.soil_points), axis=None, dtype=np.float64)
+             self.pile_rotation_rate, self.soil_points, self.pier_tops), axis=None,
+            dtype=np.float64)
 
     @property
     def stamp_ns(self) -> int:

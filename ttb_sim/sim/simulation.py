@@ -155,7 +155,11 @@ class Simulation:
                              observers=names,
                              piles=tuple((p.support + 1, p.operator.n_piles) for p in st.piled),
                              soil_points=sum(len(p.operator.soil_point_names)
-                                             for p in st.piled))
+                                             for p in st.piled),
+                             piers=tuple(k + 1 for k in st.pier_supports),
+                             soil_point_names=tuple(f'pier{p.support + 1:02d}/{name}'
+                                                    for p in st.piled
+                                                    for name in p.operator.soil_point_names))
         self._no_load = np.zeros(0)
         self._state = np.zeros((3, 0))
         self.compiled_loop = False
@@ -359,6 +363,10 @@ class Simulation:
         ue, ve, ae = self._extended(cp.structure_state())
         vehicle = cp.vehicle_outputs()
         tops = self.foundations.tops() if self.foundations.active else None
+        pier_tops = ue[st.pier_top_dofs]
+        if tops is not None:   # partitioned piled piers: their tops are not structure DOFs
+            moving = np.asarray(st.pier_supports)
+            pier_tops = np.where(st.pier_top_dofs == st.n_free, tops[0][moving, :3], pier_tops)
         piles = pile_outputs(st, self.foundations, ue, ve, ae)
         if piles:
             self.rigid.update(ue[st.midspan_dofs], piles['pile_displacement'])
@@ -370,4 +378,5 @@ class Simulation:
                      bearings=bearing_forces(st, ue, ve, ae, load, tops),
                      body_acceleration=vehicle.body_acceleration,
                      body_angular_velocity=vehicle.body_angular_velocity,
-                     wheel_rail=vehicle.wheel_rail, observers=self._observe(ue), **piles)
+                     wheel_rail=vehicle.wheel_rail, observers=self._observe(ue),
+                     pier_tops=pier_tops, **piles)

@@ -271,3 +271,22 @@ def test_imaginary_shift_interpolates_the_response_there(full):
     reference = red.dynamic_flexibility(full.mass, full.damping, full.stiffness, frequency)
     assert op.summary['basis'] <= 12
     assert _frf_error(op, reference, frequency)[0] < 1e-8
+
+
+def test_a_build_reports_each_shift_with_its_percentage(caplog):
+    """Three shifts: three lines at 33, 67 and 100 %, the first two with the time left."""
+    caplog.set_level(logging.INFO, logger='ttb_sim.model.foundation.reduction')
+    shifts = ReductionParameters(shifts=(0.0, 5.0, 10.0), levels=2)
+    _operator(shifts, cache=False)
+    lines = [r.getMessage() for r in caplog.records if 'shifts done' in r.getMessage()]
+    assert [line.split(' shifts done ')[1].split(')')[0] for line in lines] == [
+        '(33 %', '(67 %', '(100 %']
+    assert all('left' in line for line in lines[:2]) and 'left' not in lines[2]
+
+
+def test_progress_is_a_warning_only_for_a_long_build():
+    """The terminal shows a build of minutes; a build of seconds stays at INFO."""
+    assert red.BuildProgress(5, red.build_seconds(81_648, 5)).level == logging.WARNING
+    assert red.BuildProgress(2, red.build_seconds(18_144, 2)).level == logging.INFO
+    paper, live = red.build_seconds(81_648, 5), red.build_seconds(18_144, 2)
+    assert 300 < paper < 900 and 4 < live < 12   # measured: 509 s and 6.7-8.1 s

@@ -47,15 +47,18 @@ FACTORIZATION = 'cholmod'
 """Factorisation of the shifted pencils (falls back as :func:`factorize` says)."""
 
 
-def reduction_basis(tied: TiedSubstructure, reduction: ReductionParameters
+def reduction_basis(tied: TiedSubstructure, reduction: ReductionParameters,
+                    progress: Callable[[int], None] | None = None
                     ) -> tuple[np.ndarray, np.ndarray]:
     """
     Return the static modes Psi (n_x, 6) and the interior Krylov basis V (n_x - 6, r).
 
     Psi has the identity on the master and the static interior response
     -K_ii^-1 K_ib below it; V is mass-orthonormal (V^T M_ii V = I) and zero
-    on the master. See the module docstring.
+    on the master. See the module docstring. ``progress(done)`` is called
+    after each shift with the number of shifts finished (the static one first).
     """
+    report = progress if progress is not None else (lambda done: None)
     k, c, m = tied.stiffness, tied.damping, tied.mass
     n = tied.size
     weight = m.diagonal()
@@ -68,8 +71,11 @@ def reduction_basis(tied: TiedSubstructure, reduction: ReductionParameters
     psi[6:] = np.linalg.solve(x0[:6].T, x0[6:].T).T
     del x0
     blocks: list[np.ndarray] = []
+    done = 0
     if 0.0 in reduction.shifts:
         blocks += _soar(static.solve, c, m, weight, b, reduction.levels, reduction.tolerance)
+        done += 1
+        report(done)
     del static  # one factorisation in memory at a time
     for f in reduction.shifts:
         w = 2 * math.pi * float(f)
@@ -87,6 +93,8 @@ def reduction_basis(tied: TiedSubstructure, reduction: ReductionParameters
             del solve
             blocks += [part for q in found for part in (q.real, q.imag)]
         LOG.debug('reduction: %d Krylov blocks after the shift at %g Hz', len(blocks), f)
+        done += 1
+        report(done)
     w_all = np.hstack(blocks)
     del blocks
     interior = w_all[6:] - psi[6:] @ w_all[:6]

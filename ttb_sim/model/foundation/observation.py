@@ -142,6 +142,38 @@ def _positions(spec: Substructure) -> tuple[list[tuple[float, float, float]], li
     for n, point in enumerate(obs.points):
         positions.append(tuple(float(v) for v in point))  # type: ignore[arg-type]
         names.append(f'user_{n + 1:02d}')
+    if obs.grid_spacing > 0 and piles is not None:
+        grid, grid_names = ground_grid(spec)
+        positions += [tuple(float(v) for v in p) for p in grid]  # type: ignore[misc]
+        names += grid_names
+    return positions, names
+
+
+def ground_grid(spec: Substructure) -> tuple[np.ndarray, list[str]]:
+    """
+    Return the ground-surface grid of ``spec.observation`` (positions (p, 3), names).
+
+    The grid covers the cap's footprint (the pile group's outer faces without a
+    cap) plus the margin on every side, centred on the group, with points at
+    most ``grid_spacing`` apart and on both edges; named ``grid_RR_CC`` (row
+    along y, column along x, 1-based, x fastest).
+    """
+    obs, piles = spec.observation, spec.piles
+    assert piles is not None
+    if spec.cap.enabled:
+        half = (0.5 * spec.cap.lx, 0.5 * spec.cap.ly)
+    else:
+        half = (0.5 * ((piles.cols - 1) * piles.spacing + piles.width),
+                0.5 * ((piles.rows - 1) * piles.spacing + piles.width))
+    axes = []
+    for centre, h in zip(piles.centre, half):
+        extent = h + obs.grid_margin
+        count = int(np.ceil(2 * extent / obs.grid_spacing - 1e-9)) + 1
+        axes.append(np.linspace(centre - extent, centre + extent, count))
+    x, y = np.meshgrid(*axes)
+    positions = np.column_stack([x.ravel(), y.ravel(), np.zeros(x.size)])
+    names = [f'grid_{r + 1:02d}_{c + 1:02d}' for r in range(len(axes[1]))
+             for c in range(len(axes[0]))]
     return positions, names
 
 

@@ -423,12 +423,19 @@ class Observation:
         14 along -y and +y, and midway between them (at the ground surface).
     points : tuple of (x, y, z)
         User points (m).
+    grid_spacing : float
+        Spacing (m) of a ground-surface grid over the cap's footprint (the pile
+        group's extent without a cap) plus ``grid_margin`` on every side; 0: none.
+    grid_margin : float
+        Margin of that grid beyond the footprint (m).
 
     """
 
     line_points: int = 21
     val_points: bool = True
     points: tuple[tuple[float, ...], ...] = ()
+    grid_spacing: float = 0.0
+    grid_margin: float = 0.0
 
 
 @dataclass(frozen=True)

@@ -65,7 +65,7 @@ from dataclasses import dataclass
 import logging
 import math
 import time
-from typing import Any, Iterator, Optional
+from typing import Any, Callable, Iterator, Optional
 
 import numpy as np
 import scipy.sparse as sp
@@ -86,9 +86,56 @@ from ttb_sim.model.foundation.tied import check_spec, tie_cap, TiedSubstructure
 
 LOG = logging.getLogger(__name__)
 
-BUILD_SECONDS_PER_DOF = 509.0 / (81_648 * 5)
-"""CPU seconds per DOF and shift of a reduction, measured on the paper mesh (81 648 DOFs, five
-shifts, 509 s on this 2-core machine): the order of magnitude the first-build notice gives."""
+SHIFT_SECONDS = 3.3
+"""CPU seconds of one shift (a CHOLMOD factorisation and its Krylov solves) at
+:data:`SHIFT_DOFS` DOFs, measured on this 2-core machine (the live mesh: 18 144 DOFs, 6.7-8.1 s
+for two shifts)."""
+SHIFT_DOFS = 18_000
+SHIFT_EXPONENT = 2.3
+"""Growth of a shift's cost with the DOFs of a 3-D mesh (measured: 3.2 s at 17 478 factorised
+unknowns, 11 s at 28 290, about 100 s at the paper mesh's 81 648)."""
+
+
+def build_seconds(dofs: int, shifts: int) -> float:
+    """Return the estimated CPU seconds of reducing a substructure of ``dofs`` with ``shifts``."""
+    return SHIFT_SECONDS * shifts * (dofs / SHIFT_DOFS) ** SHIFT_EXPONENT
+
+
+class BuildProgress:
+    """
+    Report a reduction's progress, shift by shift: percent done, CPU so far, time left.
+
+    The lines go to this module's logger at WARNING when the whole build is
+    estimated to take more than :data:`NOTICE_SECONDS` (so a terminal shows them
+    without ``--verbose``, and the node forwards them to its log and
+    ``/diagnostics``), at INFO otherwise. :attr:`fraction` and :attr:`remaining`
+    hold the last report for a caller that polls (the node's build status).
+    """
+
+    NOTICE_SECONDS = 20.0
+
+    def __init__(self, total: int, estimate: float) -> None:
+        self.total = max(int(total), 1)
+        self.level = logging.WARNING if estimate > self.NOTICE_SECONDS else logging.INFO
+        self.fraction = 0.0
+        self.remaining: float | None = None
+        self._start = time.process_time()
+
+    def __call__(self, done: int) -> None:
+        """Take the news that ``done`` of the shifts are finished."""
+        spent = time.process_time() - self._start
+        self.fraction = min(done / self.total, 1.0)
+        self.remaining = spent * (self.total - done) / done if done else None
+        left = '' if self.remaining is None or done == self.total else (
+            f', about {_duration(self.remaining)} left')
+        LOG.log(self.level, 'reducing the pile-soil substructure: %d of %d shifts done '
+                '(%.0f %%), %s of CPU so far%s', done, self.total, 100 * self.fraction,
+                _duration(spent), left)
+
+
+def _duration(seconds: float) -> str:
+    """Return seconds as '42 s' or '3.5 min'."""
+    return f'{seconds:.0f} s' if seconds < 90 else f'{seconds / 60:.1f} min'
 
 
 @dataclass(frozen=True)
@@ -158,15 +205,17 @@ def pile_soil_operator(spec: Substructure, pier_height: float, pier_elements: in
             LOG.info('reduced pile-soil substructure read from the cache %s', path)
             return op
     nodes = planned_nodes(spec)
-    # one line the user sees (the CLI shows warnings): the paper mesh takes minutes, once
-    LOG.warning('reducing the pile-soil substructure of %d nodes (%d DOFs) with %d shifts x '
-                '%d levels: about %.0f min of CPU the first time%s', nodes, 3 * nodes,
-                len(reduction.shifts), reduction.levels,
-                BUILD_SECONDS_PER_DOF * 3 * nodes * len(reduction.shifts) / 60.0,
-                f', then read from {path.parent}' if path is not None else '')
+    estimate = build_seconds(3 * nodes, len(reduction.shifts))
+    progress = BuildProgress(len(reduction.shifts), estimate)
+    # a line the user sees when it takes a while (the CLI shows warnings), once
+    LOG.log(progress.level, 'reducing the pile-soil substructure of %d nodes (%d DOFs) with '
+            '%d shifts x %d levels: about %s of CPU the first time%s', nodes, 3 * nodes,
+            len(reduction.shifts), reduction.levels, _duration(estimate),
+            f', then read from {path.parent}' if path is not None else '')
     start = time.process_time()
     with _one_blas_thread():
-        op = _build(spec, pier_height, pier_elements, pier_section, pier_rayleigh, reduction)
+        op = _build(spec, pier_height, pier_elements, pier_section, pier_rayleigh, reduction,
+                    progress)
     LOG.info('reduced pile-soil substructure: %d full DOFs -> %d coordinates in %.1f s of CPU',
              op.summary['full_dofs'], op.size, time.process_time() - start)
     if path is not None:
@@ -176,9 +225,10 @@ def pile_soil_operator(spec: Substructure, pier_height: float, pier_elements: in
 
 def _build(spec: Substructure, pier_height: float, pier_elements: int,
            pier_section: BeamSection, pier_rayleigh: tuple[float, float],
-           reduction: ReductionParameters) -> FoundationOperator:
+           reduction: ReductionParameters, progress: Callable[[int], None] | None = None
+           ) -> FoundationOperator:
     tied = tie_cap(build(spec))
-    psi, v = reduction_basis(tied, reduction)
+    psi, v = reduction_basis(tied, reduction, progress)
     phi = np.hstack([psi, np.vstack([np.zeros((6, v.shape[1])), v])])
     m_r = _galerkin(tied.mass, phi)
     c_r = _galerkin(tied.damping, phi)

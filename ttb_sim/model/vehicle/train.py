@@ -58,13 +58,20 @@ class MovingForces:
 
 @dataclass(frozen=True)
 class QuarterCars:
-    """One quarter car per axle (arrays of shape (n_axles,), SI units)."""
+    """
+    One quarter car per axle (arrays of shape (n_axles,), SI units).
+
+    ``axles_per_car`` groups consecutive axles into the cars they are published
+    as (``car01/axle1``..``axle4``): the four quarter cars of a car of the
+    train's layout, or one axle per car for axles placed by hand.
+    """
 
     axles: Axles
     sprung_mass: np.ndarray
     unsprung_mass: np.ndarray
     stiffness: np.ndarray
     damping: np.ndarray
+    axles_per_car: int = 1
 
     @property
     def static_load(self) -> np.ndarray:

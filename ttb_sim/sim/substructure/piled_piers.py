@@ -284,14 +284,16 @@ def pile_outputs(structure: Structure, foundations: PiledFoundations, ue: np.nda
         else:
             state = next(states)
             q, qv, qa = state.u, state.v, state.a
-        disp.append((op.pile_heads @ q).reshape(-1, 3))
-        acc.append((op.pile_heads @ qa).reshape(-1, 3))
+        states_q = np.column_stack([q, qa, qv])   # one product per operator, not three
+        heads = op.pile_heads @ states_q[:, :2]
+        disp.append(heads[:, 0].reshape(-1, 3))
+        acc.append(heads[:, 1].reshape(-1, 3))
         rot.append((op.pile_rotations @ qv).reshape(-1, 3) if op.pile_rotations is not None
                    else np.zeros((op.n_piles, 3)))
         origin = np.array([pier.support * structure.girder.span_length, 0.0, -op.depth])
+        points = (op.soil_points @ states_q).reshape(-1, 3, 3)   # (point, axis, u|a|v)
         soil.append(np.hstack([op.soil_point_positions + origin,
-                               (op.soil_points @ q).reshape(-1, 3),
-                               (op.soil_points @ qa).reshape(-1, 3)]))
+                               *points.transpose(2, 0, 1)]))
     return {'pile_displacement': np.vstack(disp), 'pile_acceleration': np.vstack(acc),
             'pile_rotation_rate': np.vstack(rot), 'soil_points': np.vstack(soil)}
 

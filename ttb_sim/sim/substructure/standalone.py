@@ -158,7 +158,9 @@ class SubstructureRun:
         model = self.model
         self.layout = Layout(n_spans=0, n_supports=0, n_bodies=0,
                              piles=((1, model.n_piles),),
-                             soil_points=len(model.soil_points.names), train=False)
+                             soil_points=len(model.soil_points.names), train=False,
+                             soil_point_names=tuple(f'pier01/{name}'
+                                                    for name in model.soil_points.names))
         self.scheme: Literal['mixed', 'implicit'] = (
             'implicit' if self.variant.pile_soil_scheme == 'implicit' else 'mixed')
         self.stable_step = math.inf
@@ -258,7 +260,7 @@ class SubstructureRun:
                                   f'{limit:g} m')
         obs = observe(self.model, state)
         points = np.hstack([self.model.soil_points.positions, obs.soil_displacement,
-                            obs.soil_acceleration])
+                            obs.soil_acceleration, obs.soil_velocity])
         empty = np.zeros((0, 3))
         return Frame(step=step, time=state.time, head_position=0.0, speed=0.0,
                      midspan=empty, bearings=np.zeros((0, 2, 3)),

@@ -87,8 +87,8 @@ class PileSoilFrame:
         Pile-head area-weighted mean displacement (m) and acceleration (m/s^2).
     pile_rotation, pile_rotation_rate : arrays, shape (n_piles, 3)
         Pile-head rigid rotation (rad) and rotation rate (rad/s).
-    soil_displacement, soil_acceleration : arrays, shape (n_points, 3)
-        At the model's soil points (m, m/s^2).
+    soil_displacement, soil_acceleration, soil_velocity : arrays, shape (n_points, 3)
+        At the model's soil points (m, m/s^2, m/s).
 
     """
 
@@ -99,6 +99,7 @@ class PileSoilFrame:
     pile_rotation_rate: np.ndarray
     soil_displacement: np.ndarray
     soil_acceleration: np.ndarray
+    soil_velocity: np.ndarray
 
 
 @dataclass(frozen=True)
@@ -120,7 +121,7 @@ def observe(model: PileSoilModel, state: State) -> PileSoilFrame:
     return PileSoilFrame(state.time, (hd @ state.u).reshape(n_p, 3),
                          (hd @ state.a).reshape(n_p, 3), (hr @ state.u).reshape(n_p, 3),
                          (hr @ state.v).reshape(n_p, 3), (sp_op @ state.u).reshape(n_s, 3),
-                         (sp_op @ state.a).reshape(n_s, 3))
+                         (sp_op @ state.a).reshape(n_s, 3), (sp_op @ state.v).reshape(n_s, 3))
 
 
 def _interface_response(model: PileSoilModel, u: np.ndarray, slip: Optional[np.ndarray]

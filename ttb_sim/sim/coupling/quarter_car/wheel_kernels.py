@@ -47,6 +47,7 @@ from typing import Any
 
 import numpy as np
 
+from ttb_sim.fe.dense_kernels import solve_in_place
 from ttb_sim.sim.coupling.profile_kernels import quintic
 from ttb_sim.sim.integrators.newmark_kernels import (effective_load, finish_into, history,
                                                      largest_magnitude, solve_ldl)
@@ -54,7 +55,7 @@ from ttb_sim.sim.kernel_registry import KernelTable
 
 HELPERS = ('quintic', '_centreline_profile', '_wheel_terms', '_green_correction',
            '_update_cars', 'history', 'effective_load', 'solve_ldl', 'finish_into',
-           'largest_magnitude')
+           'largest_magnitude', 'solve_in_place')
 """Functions the kernels call: :func:`ttb_sim.fe.compiled.jit` compiles them first."""
 
 
@@ -178,8 +179,10 @@ def _green_correction(x0: np.ndarray, green: np.ndarray, slot: np.ndarray, dofs:
     """
     n_free = x0.shape[0]
     m = dofs.shape[0]
-    s = np.eye(m)
+    s = np.zeros((m, m))
     t = np.zeros(m)
+    for i in range(m):
+        s[i, i] = 1.0
     for i in range(m):
         for ka in range(4):
             dof = dofs[i, ka]
@@ -193,12 +196,13 @@ def _green_correction(x0: np.ndarray, green: np.ndarray, slot: np.ndarray, dofs:
                 for kb in range(4):
                     acc += w[i, ka] * green[row, slot[dofs[j, kb]]] * n0[j, kb]
             s[i, j] += acc
-    y = np.linalg.solve(s, t)
+    if not solve_in_place(s, t):
+        t[:] = np.nan   # a singular wheel system: the divergence check stops the run
     for j in range(m):
         for kb in range(4):
             dof = dofs[j, kb]
             if dof < n_free:
-                load[dof] -= n0[j, kb] * y[j]
+                load[dof] -= n0[j, kb] * t[j]
 
 
 def _update_cars(u: np.ndarray, dofs: np.ndarray, w: np.ndarray, p: np.ndarray,

@@ -288,8 +288,6 @@ class QuarterCarTrain(FreeDofState):
 
     """
 
-    n_axles = 1
-
     def __init__(self, cars: QuarterCars, structure: Structure, integrator: Integrator,
                  irregularity: TrackIrregularity | None) -> None:
         self.cars = cars
@@ -297,7 +295,10 @@ class QuarterCarTrain(FreeDofState):
         self.nm = integrator
         self.irregularity = irregularity
         self.kernel = QuarterCarCoupling(cars, structure.girder, integrator, structure.n_free)
-        self.n_bodies = cars.axles.count
+        self.n_axles = cars.axles_per_car
+        """Axles per published car (:attr:`QuarterCars.axles_per_car`)."""
+        self.n_bodies = cars.axles.count // cars.axles_per_car
+        """Published cars: each the mean of its quarter cars' sprung masses."""
         n_free = structure.n_free
         self.u = np.zeros(n_free)
         self.v = np.zeros(n_free)
@@ -406,10 +407,18 @@ class QuarterCarTrain(FreeDofState):
         return self.u, self.kernel.z
 
     def vehicle_outputs(self) -> VehicleOutputs:
-        """Return each sprung mass's vertical acceleration and its wheel's contact force."""
-        n_b = self.n_bodies
+        """
+        Return each car's body acceleration and its wheels' contact forces.
+
+        A car's body acceleration is the mean vertical acceleration of its
+        quarter cars' sprung masses (the bounce of a rigid body resting on them
+        with equal shares; a quarter car has no pitch or roll, so the angular
+        velocity is zero). Each wheel's contact force is split equally between
+        the left and right rails.
+        """
+        n_b, n_a = self.n_bodies, self.n_axles
         acc = np.zeros((n_b, 3))
-        wheel_rail = np.zeros((n_b, 1, 2, 3))
-        acc[:, 2] = self.kernel.a
-        wheel_rail[:, 0, :, 2] = 0.5 * self.kernel.contact[:, None]
+        acc[:, 2] = self.kernel.a.reshape(n_b, n_a).mean(axis=1)
+        wheel_rail = np.zeros((n_b, n_a, 2, 3))
+        wheel_rail[:, :, :, 2] = 0.5 * self.kernel.contact.reshape(n_b, n_a)[:, :, None]
         return VehicleOutputs(acc, np.zeros((n_b, 3)), wheel_rail)
