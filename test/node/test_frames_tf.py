@@ -37,7 +37,7 @@ def coupled():
 @pytest.fixture(scope='module')
 def coupled_layout(coupled):
     return Layout(n_spans=10, n_supports=11, n_bodies=4, n_axles=4,
-                  piles=((7, 15), (8, 15)), soil_points=50)
+                  piles=((7, 15), (8, 15)), soil_points=50, piers=(7, 8))
 
 
 def test_frames_are_rooted_at_track_with_valid_unique_names(coupled, coupled_layout):
@@ -57,7 +57,7 @@ def test_every_sensor_topic_has_its_frame(coupled, coupled_layout):
         parts = topic.name.split('/')
         if parts[0] == 'bridge':
             assert parts[1] in names
-        elif parts[0] == 'bearings':
+        elif parts[0] in ('bearings', 'piers'):
             assert parts[1] in names
         elif parts[0] == 'piles':
             assert f'{parts[1]}_{parts[2]}' in names

@@ -37,7 +37,7 @@ from typing import Any, Iterable, Mapping
 __all__ = ['check_rate', 'family_of', 'family_periods', 'FAMILIES', 'frame_stride',
            'RATE_PARAMETERS', 'Schedule']
 
-FAMILIES = ('train', 'wheel_rail', 'bridge', 'bearings', 'piles', 'soil', 'observers')
+FAMILIES = ('train', 'wheel_rail', 'bridge', 'bearings', 'piers', 'piles', 'soil', 'observers')
 """The topic families, by the first part of the topic name."""
 
 RATE_PARAMETERS = {f'publish_rates.{family}_hz': family for family in FAMILIES}
