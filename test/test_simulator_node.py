@@ -148,9 +148,9 @@ def test_integer_speed_accepted_and_odometry_follows(looping):
     result, _ = looping.set_parameter('train.speed_kmh', integer(350))
     assert result.successful, result.reason
     assert looping.node.get_parameter('train.speed_kmh').value == 350.0
-    n = len(speeds)
-    wait_for(lambda: len(speeds) > n + 2)
-    assert speeds[-1] == pytest.approx(97.2, abs=0.05)
+    # Frames computed before the change may still be waiting to be published (the
+    # publishing budget): the new speed shows within the bound, not at a fixed count.
+    wait_for(lambda: abs(speeds[-1] - 97.2) < 0.05)
 
 
 @pytest.mark.parametrize('overrides, words', [

@@ -46,7 +46,7 @@ from ttb_sim.inputs import shown
 from ttb_sim.io.bag import STORAGES
 from ttb_sim.node.rates import RATE_PARAMETERS
 
-DEFAULT_SCENARIO = 'live_train'
+DEFAULT_SCENARIO = 'live_coupled'
 """Scenario loaded when the ``scenario`` parameter is not given."""
 
 SCENARIO_KEYS = ('train.speed_kmh', 'irregularity.spectrum', 'irregularity.seed',
