@@ -327,3 +327,14 @@ def test_bag_holds_every_frame(tmp_path):
         counts = {c.topic: c.msgcount for c in reader.connections}
     assert found == {t.full_name(): t.msgtype for t in topic_table(layout)}
     assert set(counts.values()) == {frames}
+
+
+def test_without_tf2_msgs_the_node_runs_without_tf(monkeypatch):
+    import ttb_sim.simulator_node as shell
+    monkeypatch.setattr(shell, 'optional_message_class', lambda name: None)
+    h = Harness(scenario='moving_force_beam')
+    try:
+        assert h.node.tf_static_pub is None
+        wait_for(lambda: h.node.publish_loop is not None)   # built and publishing
+    finally:
+        h.close()
