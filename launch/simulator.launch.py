@@ -56,7 +56,7 @@ def generate_launch_description() -> LaunchDescription:
                                                                'simulator.yaml']),
             description='ROS parameters file of the ttb_sim node (ros__parameters).'),
         DeclareLaunchArgument(
-            'scenario', default_value='live_train',
+            'scenario', default_value='live_coupled',
             description='Scenario: a YAML path or a built-in name (ttb-sim scenarios).'),
         DeclareLaunchArgument('rviz', default_value='false',
                               description='Start RViz with config/ttb_sim.rviz.'),

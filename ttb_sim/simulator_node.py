@@ -27,14 +27,26 @@ stepping thread, which builds, steps, records and publishes (:mod:`ttb_sim.node`
 Publishers and their QoS (all explicit):
 
 - the topic table (:func:`ttb_sim.io.topics.topic_table`), private topics
-  ``~/...``: reliable, volatile, keep last 10 (QoS class 'sensor'); created once
-  the model is built (its sizes come from the model);
+  ``~/...``: profile 'reliable' (reliable, volatile, keep last 10; the default, so
+  that ``ros2 bag record`` and ``ros2 topic echo`` get every message) or, with
+  ``qos.reliability:=best_effort``, 'best_effort' (rclpy's
+  ``qos_profile_sensor_data``: best effort, volatile, keep last 5); created once the
+  model is built (its sizes come from the model); each topic family at its own rate
+  (``publish_rate_hz``, ``publish_rates.<family>_hz``: :mod:`ttb_sim.node.rates`);
 - ``/clock`` (when ``publish_clock``): reliable, volatile, keep last 1, so that
   both best-effort (rclcpp/rclpy time sources) and reliable subscribers match;
   it never goes backwards, and while paused or idle it repeats the current time;
-- ``/diagnostics``: reliable, volatile, keep last 10, at 1 Hz (wall clock);
+- ``/diagnostics``: reliable, volatile, keep last 10, at 1 Hz of wall clock,
+  stamped with simulation time like every data topic;
 - ``~/model/markers``: reliable, transient local, keep last 1 (latched: a late
-  RViz gets the structure and the latest train position).
+  RViz gets the structure and the latest train position);
+- ``/tf_static`` (``tf2_msgs/msg/TFMessage``, when tf2_msgs is installed): reliable,
+  transient local, keep last 1, one message once the model is built: the frames of
+  :mod:`ttb_sim.node.frames_tf` under ``track``.
+
+The library's log records (:mod:`logging`) go to the node's ROS logger, each warning
+once per node life (:mod:`ttb_sim.node.logs`); BLAS is held at one thread
+(:mod:`ttb_sim.node.threads`); at shutdown one line says what ran.
 
 Timers use the steady clock, so ``use_sim_time`` (driven by this node's own
 /clock) cannot stall them. On shutdown, SIGINT and SIGTERM the publishing stops
@@ -44,6 +56,7 @@ parameter values and types, bag destination) are one FATAL line and exit code 2.
 
 from __future__ import annotations
 
+from dataclasses import replace
 import functools
 from pathlib import Path
 import sys
@@ -71,15 +84,20 @@ from ttb_sim.io.topics import Topic, topic_table
 from ttb_sim.node import (markers, NodeParameter, PassageController, validate_changes,
                           validate_parameter)
 from ttb_sim.node.diagnostics import diagnostic_array
+from ttb_sim.node.frames_tf import static_frames, tf_message
+from ttb_sim.node.logs import ForwardingHandler, install
 from ttb_sim.node.markers import marker_array
 from ttb_sim.node.message_cache import MessageCache
+from ttb_sim.node.parameters import descriptor_range, NumericRange
 from ttb_sim.node.passage import Tick
 from ttb_sim.node.publishing import PublishLoop
+from ttb_sim.node.rates import RATE_PARAMETERS
 from ttb_sim.node.runs import FrameSink
 from ttb_sim.node.shell import (bag_destination, building_message, ClockGuard,
                                 declare_parameters, live_topics, node_diagnostics, open_bag,
-                                pause_answer, quiet_repeated_warnings, tick_messages)
+                                pause_answer, qos_class, shutdown_line, tick_messages)
 from ttb_sim.node.stepper import Stepper
+from ttb_sim.node.threads import hold_blas_threads
 from ttb_sim.sim import Frame, Layout
 from visualization_msgs.msg import MarkerArray
 
@@ -89,11 +107,17 @@ PUBLISH_DUTY = 0.2
 """Largest share of the processor (CPU time) publishing may take."""
 PAUSED_CLOCK_PERIOD = 0.1
 """Wall-clock seconds between two /clock messages while paused or idle."""
+BUILD_LOG_PERIOD = 10.0
+"""Wall-clock seconds between two "building model" progress lines."""
 
 QOS = {
-    'sensor': QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=10,
-                         reliability=ReliabilityPolicy.RELIABLE,
-                         durability=DurabilityPolicy.VOLATILE),
+    'reliable': QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=10,
+                           reliability=ReliabilityPolicy.RELIABLE,
+                           durability=DurabilityPolicy.VOLATILE),
+    # rclpy's qos_profile_sensor_data, spelled out
+    'best_effort': QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=5,
+                              reliability=ReliabilityPolicy.BEST_EFFORT,
+                              durability=DurabilityPolicy.VOLATILE),
     'clock': QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=1,
                         reliability=ReliabilityPolicy.RELIABLE,
                         durability=DurabilityPolicy.VOLATILE),
@@ -101,8 +125,8 @@ QOS = {
                           reliability=ReliabilityPolicy.RELIABLE,
                           durability=DurabilityPolicy.TRANSIENT_LOCAL),
 }
-"""QoS of each topic-table QoS class."""
-DIAGNOSTICS_QOS = QOS['sensor']
+"""The node's QoS profiles, by name (:func:`ttb_sim.node.shell.qos_class` maps the topics')."""
+DIAGNOSTICS_QOS = QOS['reliable']
 
 _PARAM_TYPES = {'bool': ParameterType.PARAMETER_BOOL,
                 'integer': ParameterType.PARAMETER_INTEGER,
@@ -116,18 +140,52 @@ def message_class(name: str) -> Any:
     return get_message(name)
 
 
-def descriptor(param: NodeParameter) -> ParameterDescriptor:
+def ros_log(logger: Any, level: str, message: str) -> None:
+    """
+    Log at a level given by name ('debug' .. 'fatal') through an rclpy logger.
+
+    rclpy ties a severity to each calling line (it refuses another severity from the
+    same line), so each level has a call of its own.
+    """
+    if level == 'debug':
+        logger.debug(message)
+    elif level == 'info':
+        logger.info(message)
+    elif level == 'warning':
+        logger.warning(message)
+    elif level == 'error':
+        logger.error(message)
+    else:
+        logger.fatal(message)
+
+
+def optional_message_class(name: str) -> Any:
+    """Return a message class, or None when its package is not installed (tf2_msgs)."""
+    try:
+        return message_class(name)
+    except (ImportError, AttributeError, ValueError):
+        return None
+
+
+def descriptor(param: NodeParameter, numeric: NumericRange | None = None,
+               allowed: str | None = None) -> ParameterDescriptor:
     """
     Build the ROS parameter descriptor of a node parameter.
 
     Double parameters use dynamic typing so that an integer (``350``) is
     accepted; the on-set callback validates numerically and the pre-set
-    callback stores the value as a double.
+    callback stores the value as a double. The range is exactly what the
+    validation accepts (:func:`~ttb_sim.node.parameters.descriptor_range`).
 
     Parameters
     ----------
     param : NodeParameter
         The parameter's declaration.
+    numeric : NumericRange, optional
+        A narrower range than the declaration's (a family's rate once the
+        model's output rate is known).
+    allowed : str, optional
+        The allowed values in words, for that narrower range.
 
     Returns
     -------
@@ -135,17 +193,17 @@ def descriptor(param: NodeParameter) -> ParameterDescriptor:
 
     """
     d = ParameterDescriptor(type=_PARAM_TYPES[param.kind], description=param.description(),
-                            additional_constraints=f'allowed: {param.allowed()}',
+                            additional_constraints=f'allowed: {allowed or param.allowed()}',
                             read_only=param.read_only,
                             dynamic_typing=param.accepts_integer)
-    spec = param.spec
-    if spec.low is not None and spec.high is not None:
-        if param.kind == 'double':
-            d.floating_point_range = [FloatingPointRange(
-                from_value=float(spec.low), to_value=float(spec.high), step=0.0)]
-        elif param.kind == 'integer':
-            d.integer_range = [IntegerRange(from_value=int(spec.low), to_value=int(spec.high),
-                                            step=1)]
+    rng = numeric or descriptor_range(param)
+    if rng is not None and param.kind == 'double':
+        d.floating_point_range = [FloatingPointRange(
+            from_value=float(rng.from_value), to_value=float(rng.to_value),
+            step=float(rng.step))]
+    elif rng is not None and param.kind == 'integer':
+        d.integer_range = [IntegerRange(from_value=int(rng.from_value),
+                                        to_value=int(rng.to_value), step=int(rng.step))]
     return d
 
 
@@ -184,6 +242,11 @@ class SimulatorNode(Node):
         self._clock_guard = ClockGuard()
         self._last_build_log = 0.0
         self._closed = False
+        self._bag_path: Path | None = None
+        self.tf_static_pub: Any = None
+        self._restore_blas = hold_blas_threads()   # before any numpy work of the model
+        self._log_handler = ForwardingHandler(self._forward_log)
+        self._uninstall_log = install(self._log_handler)
         try:
             self._configure()
         except BaseException:   # a bad value, or Ctrl-C in the middle of the set-up
@@ -212,7 +275,6 @@ class SimulatorNode(Node):
                                 f'{param.allowed()})') from None
 
     def _configure(self) -> None:
-        quiet_repeated_warnings()
         start = declare_parameters(self._declare)
         scenario, self.table, values = start.scenario, start.table, start.values
         self.scenario, self.values = scenario, values
@@ -224,6 +286,7 @@ class SimulatorNode(Node):
 
         self.namespace = self.get_fully_qualified_name()
         path = bag_destination(values, scenario.name)
+        self._bag_path = path
         open_recorder = None if path is None else \
             functools.partial(self._open_recorder, path, values['bag.storage'])
 
@@ -232,6 +295,12 @@ class SimulatorNode(Node):
                                                      DIAGNOSTICS_QOS)
         self.markers_pub = self.create_publisher(MarkerArray, '~/model/markers',
                                                  QOS['latched'])
+        tf_type = optional_message_class('tf2_msgs/msg/TFMessage')
+        if tf_type is not None:
+            self.tf_static_pub = self.create_publisher(tf_type, '/tf_static', QOS['latched'])
+        else:
+            self.get_logger().info('tf2_msgs is not installed: no static TF frames on '
+                                   '/tf_static (apt install ros-jazzy-tf2-msgs)')
         self.create_service(Trigger, '~/reset', self._on_reset)
         self.create_service(SetBool, '~/pause', self._on_pause)
         steady = Clock(clock_type=ClockType.STEADY_TIME)
@@ -263,7 +332,14 @@ class SimulatorNode(Node):
     def _log(self, level: str, message: str) -> None:
         """Log through rclpy while the context is valid (never after shutdown: no rosout)."""
         if self.context.ok() and not self._closed:
-            getattr(self.get_logger(), level)(message)
+            ros_log(self.get_logger(), level, message)
+
+    def _forward_log(self, level: str, message: str) -> bool:
+        """Log a library record through rclpy; False once the node is closed."""
+        if not self.context.ok() or self._closed:
+            return False
+        ros_log(self.get_logger(), level, message)
+        return True
 
     def _stepper_failed(self, message: str, code: int) -> None:
         """Hand a build failure to the executor (runs on the stepping thread)."""
@@ -281,11 +357,16 @@ class SimulatorNode(Node):
             return
         self.topics = topic_table(controller.layout)
         live = live_topics(self.topics)
+        reliability = str(self.values['qos.reliability'])
         for topic, name in live:
             self.publishers_by_name[topic.name] = self.create_publisher(
-                message_class(topic.msgtype), name, QOS[topic.qos])
+                message_class(topic.msgtype), name, QOS[qos_class(topic.qos, reliability)])
         self._live = [self.publishers_by_name[t.name] for t, _ in live]
         self._messages = MessageCache([t for t, _ in live], message_class)
+        self._narrow_rate_ranges(controller.output_period)
+        if self.tf_static_pub is not None:
+            self.tf_static_pub.publish(tf_message(
+                message_class, static_frames(self.scenario, controller.layout)))
         self.publish_loop = PublishLoop(self._publish_frames, duty=PUBLISH_DUTY,
                                         threaded=False)
         self.publish_loop.start()
@@ -295,6 +376,24 @@ class SimulatorNode(Node):
         self.get_logger().info(
             f'model built in {status.elapsed:.2f} s: {controller.sim.dt:.3g} s steps, '
             f'{len(self.topics)} topics under {self.namespace}/; publishing')
+
+    def _narrow_rate_ranges(self, output_period: float) -> None:
+        """Make the family rates' descriptors end at the model's output rate."""
+        if output_period <= 0:
+            return
+        output_rate = 1.0 / output_period
+        for name in RATE_PARAMETERS:
+            param = self.table[name]
+            rng = descriptor_range(param)
+            if rng is None or rng.to_value <= output_rate:
+                continue
+            narrow = replace(rng, to_value=output_rate)
+            try:
+                self.set_descriptor(name, descriptor(
+                    param, narrow, f'[0, {output_rate:g}] Hz (the output rate of this model; '
+                    '0 = publish_rate_hz)'))
+            except Exception as exc:  # noqa: B902 - the on-set check refuses them anyway
+                self.get_logger().debug(f'{name}: range not narrowed: {exc}')
 
     # -- parameters ---------------------------------------------------------------------
 
@@ -313,6 +412,9 @@ class SimulatorNode(Node):
         """Validate proposed values; a refusal changes nothing and names the range."""
         known = {p.name: p.value for p in parameters if p.name in self.table}
         ok, reason = validate_changes(self.table, known)
+        controller = self.controller
+        if ok and controller is not None:
+            ok, reason = controller.check_rates(known)
         return SetParametersResult(successful=ok, reason=reason)
 
     def _post_set(self, parameters: list[Parameter]) -> None:
@@ -357,24 +459,25 @@ class SimulatorNode(Node):
         for level, message in tick_messages(tick, self.controller):
             self._log(level, message)
         if self.publish_loop is not None:
-            self.publish_loop.offer(tick.frames, tick.markers)
+            self.publish_loop.offer(list(zip(tick.frames, tick.due)), tick.markers)
 
-    def _publish_frames(self, frames: Sequence[Frame], refresh_markers: bool) -> None:
-        """Send each frame's messages in order (stepping thread), updated in place."""
-        if not frames and not refresh_markers:
+    def _publish_frames(self, items: Sequence[tuple[Frame, frozenset[str]]],
+                        refresh_markers: bool) -> None:
+        """Send each frame's due messages in order (stepping thread), updated in place."""
+        if not items and not refresh_markers:
             return
         cache = self._messages
         try:
             clock = bool(self.values['publish_clock'])
-            for frame in frames:
+            for frame, due in items:
                 if not self.context.ok() or cache is None:
                     return
                 if clock:
                     self._publish_clock(frame.stamp_ns)
-                for publisher, msg in zip(self._live, cache.messages(frame)):
-                    publisher.publish(msg)
-            if refresh_markers and frames:
-                self._publish_markers(frames[-1].head_position)
+                for index, msg in cache.due_messages(frame, due):
+                    self._live[index].publish(msg)
+            if refresh_markers and items:
+                self._publish_markers(items[-1][0].head_position)
         except Exception as exc:  # noqa: B902 - shutting down under our feet
             if self.context.ok() and not self._closed:
                 raise
@@ -403,7 +506,7 @@ class SimulatorNode(Node):
         controller = self.controller
         status = self.stepper.status()
         if (controller is None and status.state != 'failed'
-                and status.elapsed - self._last_build_log >= 2.0):
+                and status.elapsed - self._last_build_log >= BUILD_LOG_PERIOD):
             self._last_build_log = status.elapsed
             self.get_logger().info(f'building model {self.scenario.name!r}: '
                                    f'{status.elapsed:.1f} s so far')
@@ -412,19 +515,35 @@ class SimulatorNode(Node):
                                   controller.diagnostics() if controller is not None else None,
                                   loop.stats() if loop is not None else None,
                                   loop.error if loop is not None else '')
+        # Simulation time, like every data topic (0 while the model is being built).
+        sim_ns = round(controller.node_time * 1e9) if controller is not None else 0
+        sec, nanosec = divmod(sim_ns, 1_000_000_000)
         self.diagnostics_pub.publish(diagnostic_array(
             message_class, report, 'ttb_sim: simulation', self.get_name(),
-            self.get_clock().now().to_msg()))
+            Time(sec=sec, nanosec=nanosec)))
 
     def close(self) -> None:
-        """Stop publishing, then stepping; the bag is closed on the stepping thread."""
-        self._closed = True   # from here on nothing is published or logged through rclpy
+        """Stop publishing, then stepping (the bag closes on its thread); log what ran."""
+        if self._closed:
+            return
+        self._closed = True   # from here on nothing is published through rclpy
         if self.publish_loop is not None:
             self.publish_loop.stop()
         building = self.stepper is not None and self.stepper.status().state == 'building'
+        # Once rclpy shuts down (SIGINT, possibly while this runs) the node's logger cannot
+        # reach /rosout any more; a child logger is not tied to /rosout, so it always logs
+        # (console and log file), whenever the shutdown comes.
+        logger = get_logger(f'{self.get_name()}.shutdown')
         if self.stepper is not None and not self.stepper.stop(timeout=1.0 if building else 10.0):
-            self._log('warning', 'the model is still being built; leaving it behind (no bag '
-                      'was open yet)')
+            logger.warning('the model is still being built; leaving it behind (no bag was '
+                           'open yet)')
+        if self.stepper is not None:
+            published = self.publish_loop.stats().published if self.publish_loop else 0
+            logger.info(shutdown_line(self.controller, published, self._bag_path))
+        self._uninstall_log()
+        if self._restore_blas is not None:
+            self._restore_blas()
+            self._restore_blas = None
 
 
 def _shutting_down(context: Any = None) -> bool:

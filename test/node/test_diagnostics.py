@@ -17,7 +17,8 @@
 import pytest
 from ttb_sim.io.cdr import typestore
 from ttb_sim.node.diagnostics import (diagnostic_array, DiagnosticsReport, ERROR, OK,
-                                      passage_level, StepMeter, StepWindow, WARN)
+                                      passage_level, SlidingWindow, StepMeter, StepWindow,
+                                      WARN)
 
 
 def test_the_meter_gives_the_window_since_the_last_reading():
@@ -38,7 +39,11 @@ def test_the_meter_gives_the_window_since_the_last_reading():
 def test_the_level_of_a_passage():
     slow = StepWindow(wall=1.0, simulated=0.5, steps=10, stepping=0.9, cpu=0.9)
     assert passage_level('running', '', '', 3, 1.0, slow) == (
-        WARN, 'slower than requested: real-time factor 0.50 < 1')
+        WARN, 'slower than requested: real-time factor 0.50 over the last 1.0 s < 1 (50 % short)')
+    nearly = StepWindow(wall=5.0, simulated=4.8, steps=10, stepping=0.9, cpu=0.9)
+    assert passage_level('running', '', '', 3, 1.0, nearly) == (OK, 'running, passage 3')
+    short = StepWindow(wall=5.0, simulated=4.7, steps=10, stepping=0.9, cpu=0.9)
+    assert passage_level('running', '', '', 3, 1.0, short)[1].endswith('(6 % short)')
     assert passage_level('running', '', '', 3, 0.0, slow) == (OK, 'running, passage 3')
     assert passage_level('paused', '', '', 3, 1.0, slow) == (OK, 'paused, passage 3')
     assert passage_level('diverged', 'NaN at step 7', '', 3, 1.0, slow) == (
@@ -61,3 +66,15 @@ def test_the_diagnostic_array_carries_the_report():
     assert status.level == bytes([WARN]) and status.message == 'slow'
     assert (status.name, status.hardware_id) == ('ttb_sim: simulation', 'ttb_sim')
     assert [(kv.key, kv.value) for kv in status.values] == list(report.values)
+
+
+def test_the_sliding_window_covers_the_last_five_seconds():
+    sliding = SlidingWindow(5.0)
+    for k in range(8):   # 1 s windows: 1 s simulated each, then 0.5 s from the 6th on
+        rate = 1.0 if k < 5 else 0.5
+        over = sliding.add(StepWindow(wall=1.0, simulated=rate, steps=10, stepping=0.5,
+                                      cpu=0.5))
+    assert over.wall == 5.0
+    assert over.real_time_factor == pytest.approx((2 * 1.0 + 3 * 0.5) / 5)
+    sliding.clear()
+    assert sliding.add(StepWindow(1.0, 0.9, 1, 0.1, 0.1)).real_time_factor == pytest.approx(0.9)

@@ -21,19 +21,22 @@ import math
 import pytest
 from ttb_sim.config import key_spec
 from ttb_sim.errors import ScenarioError
-from ttb_sim.node.parameters import (initial_values, parameter_table, SCENARIO_KEYS,
+from ttb_sim.node.parameters import (descriptor_range, initial_values, parameter_table,
+                                     SCENARIO_KEYS,
                                      validate_changes, validate_parameter)
+from ttb_sim.node.rates import RATE_PARAMETERS
 
 CONTRACT_PARAMETERS = {
     'scenario', 'train.speed_kmh', 'irregularity.spectrum', 'irregularity.seed',
     'irregularity.file', 'irregularity.scale', 'publish_rate_hz', 'real_time_factor', 'loop',
     'publish_clock', 'bag.enabled', 'bag.path', 'bag.storage'}
+NODE_PARAMETERS = CONTRACT_PARAMETERS | set(RATE_PARAMETERS) | {'qos.reliability'}
 
 
 # -- parameter table ------------------------------------------------------------------------
 
-def test_parameter_names_are_the_contract(beam):
-    assert set(parameter_table(beam)) == CONTRACT_PARAMETERS
+def test_parameter_names_are_the_contract_and_the_node_extras(beam):
+    assert set(parameter_table(beam)) == NODE_PARAMETERS
 
 
 def test_scenario_parameters_come_from_the_schema(beam):
@@ -64,7 +67,7 @@ def test_descriptions_carry_unit_range_and_when_changes_apply(beam):
 
 def test_read_only_parameters_are_structural(beam):
     ro = {n for n, p in parameter_table(beam).items() if p.read_only}
-    assert ro == {'scenario', 'bag.enabled', 'bag.path', 'bag.storage'}
+    assert ro == {'scenario', 'bag.enabled', 'bag.path', 'bag.storage', 'qos.reliability'}
 
 
 def test_spectrum_choices_are_read_from_the_schema(beam):
@@ -128,3 +131,56 @@ def test_start_up_values_validated_and_normalised(beam):
         initial_values(table, {'train.speed_kmh': -5})
     with pytest.raises(ScenarioError, match=r"bag\.storage = 'zip'.*'mcap', 'sqlite3'"):
         initial_values(table, {'bag.storage': 'zip'})
+
+
+# -- descriptor ranges ----------------------------------------------------------------------
+
+PARAM_REL_TOL = 1e-6
+"""rclpy's Node.PARAM_REL_TOL (jazzy): a value this close to a bound is always accepted."""
+
+
+def rclpy_accepts(rng, value) -> bool:
+    """Emulate rclpy's range check of a descriptor (jazzy node.py _apply_*_range)."""
+    if isinstance(rng.step, int):   # IntegerRange
+        return rng.from_value <= value <= rng.to_value
+    if (math.isclose(value, rng.from_value, rel_tol=PARAM_REL_TOL)
+            or math.isclose(value, rng.to_value, rel_tol=PARAM_REL_TOL)):
+        return True
+    return rng.from_value < value < rng.to_value
+
+
+def probes(param):
+    spec = param.spec
+    out = [0, 1, -1, 0.5, 1e-300, -1e-300, 350, 1e9, -1e9]
+    for bound in (spec.low, spec.high):
+        if bound is not None:
+            out += [bound, bound + 1, bound - 1, bound * (1 + 1e-3) + 1e-3,
+                    bound * (1 - 1e-3) - 1e-3]
+    if param.kind == 'integer':
+        return sorted({int(v) for v in out})
+    return sorted({float(v) for v in out})
+
+
+def test_the_speed_range_says_zero_is_refused(beam):
+    param = parameter_table(beam)['train.speed_kmh']
+    rng = descriptor_range(param)
+    assert rng.from_value > 0 and rng.from_value == math.nextafter(0.0, 1.0)
+    assert not rclpy_accepts(rng, 0.0)
+    assert not validate_parameter(param, 0.0)[0]
+    assert validate_parameter(param, rng.from_value)[0]
+    assert rng.to_value == 10000.0 and rng.step == 0.0
+
+
+@pytest.mark.parametrize('name', sorted(NODE_PARAMETERS))
+def test_descriptor_range_is_exactly_what_validation_accepts(beam, name):
+    param = parameter_table(beam)[name]
+    rng = descriptor_range(param)
+    if param.kind not in ('double', 'integer'):
+        assert rng is None
+        return
+    assert rng is not None, f'{name} has a numeric range but no descriptor range'
+    for value in probes(param):
+        if name == 'irregularity.file':
+            continue
+        ok = validate_parameter(param, value, initial=True)[0]
+        assert ok == rclpy_accepts(rng, value), (name, value, rng)

@@ -350,3 +350,27 @@ def test_the_pace_runs_on_across_loop_restarts(beam):
     elapsed = clock.now - start
     # Within one frame of the wall clock: a re-anchor at every restart lost 0.05 s per passage.
     assert c.node_time == pytest.approx(elapsed, abs=c.frame_period + 1e-9)
+
+
+def test_a_slow_passage_build_is_caught_up_not_lost(beam, monkeypatch):
+    """A loop restart whose build takes longer than MAX_LAG (a loaded machine) loses no time."""
+    import ttb_sim.node.passage as passage
+    clock = FakeClock()
+    c = controller(beam, clock=clock, loop=True, real_time_factor=1.0)
+    build = passage.make_runner
+
+    def slow_build(scenario):
+        clock.now += passage.MAX_LAG + 0.1   # the build's wall time, on the test's clock
+        return build(scenario)
+    monkeypatch.setattr(passage, 'make_runner', slow_build)
+    start = clock.now
+    per_tick = round(0.1 / c.frame_period)   # stepping at twice real time: a catch-up of
+    c.advance(budget=5.0)                     # a build spans several ticks
+    while c.passage < 5:
+        clock.now += 0.05
+        c.advance(budget=5.0, max_frames=per_tick)
+    for _ in range(int(2 * (passage.MAX_LAG + 0.1) / 0.05)):   # catch the last build up
+        clock.now += 0.05
+        c.advance(budget=5.0, max_frames=per_tick)
+    # A re-anchor in the middle of each catch-up lost about 0.5 s a passage.
+    assert c.node_time == pytest.approx(clock.now - start, abs=0.1)

@@ -14,7 +14,6 @@
 
 """Tests of the ROS-free half of the rclpy shell (ttb_sim.node.shell)."""
 
-import logging
 import threading
 
 import pytest
@@ -25,9 +24,8 @@ from ttb_sim.node.parameters import initial_values, parameter_table
 from ttb_sim.node.passage import PassageController, Tick
 from ttb_sim.node.publishing import PublishStats
 from ttb_sim.node.shell import (bag_destination, building_message, ClockGuard,
-                                declare_parameters, live_topics, node_diagnostics, ONCE_LOGGERS,
-                                OnceFilter, open_bag, pause_answer, quiet_repeated_warnings,
-                                tick_messages)
+                                declare_parameters, live_topics, node_diagnostics, open_bag,
+                                pause_answer, qos_class, shutdown_line, tick_messages)
 from ttb_sim.node.stepper import StepperStatus
 from ttb_sim.sim import Simulation
 
@@ -51,15 +49,25 @@ def test_a_scenario_that_does_not_load_is_a_scenario_error():
         declare_parameters(lambda name, default, param: 'no_such_scenario')
 
 
-def test_repeated_model_warnings_pass_once():
-    assert ONCE_LOGGERS == (Simulation.__module__,)
-    quiet_repeated_warnings()
-    quiet_repeated_warnings()
-    logger = logging.getLogger(ONCE_LOGGERS[0])
-    assert sum(isinstance(f, OnceFilter) for f in logger.filters) == 1
-    once = OnceFilter()
-    record = logging.LogRecord('x', logging.WARNING, __file__, 1, 'same %s', ('text',), None)
-    assert once.filter(record) and not once.filter(record)
+def test_qos_classes_say_what_they_are():
+    assert qos_class('sensor', 'reliable') == 'reliable'
+    assert qos_class('sensor', 'best_effort') == 'best_effort'
+    assert qos_class('clock', 'best_effort') == 'clock'
+    assert qos_class('latched', 'best_effort') == 'latched'
+    with pytest.raises(ValueError, match='unknown topic QoS class'):
+        qos_class('fast', 'reliable')
+
+
+def test_the_shutdown_line_says_what_ran(beam, tmp_path):
+    assert 'before the model was built' in shutdown_line(None, 0, None)
+    c = PassageController(beam, initial_values(parameter_table(beam),
+                                               {'real_time_factor': 0.0, 'loop': False}))
+    c.advance(budget=5.0, max_frames=20)
+    line = shutdown_line(c, 7, tmp_path / 'bag')
+    assert line.startswith('shutting down: 1 passage(s), ')
+    assert 's simulated' in line and 'real-time factor' in line
+    assert '7 frames published' in line and str(tmp_path / 'bag') in line
+    assert 'recorded' not in shutdown_line(c, 7, None)
 
 
 def test_the_bag_destination(beam, tmp_path):

@@ -26,6 +26,7 @@ headline values; :func:`diagnostic_array` copies a report into a
 
 from __future__ import annotations
 
+from collections import deque
 from dataclasses import dataclass
 from typing import Any
 
@@ -34,6 +35,12 @@ from ttb_sim.sim import Frame
 
 OK, WARN, ERROR = 0, 1, 2
 """The ``diagnostic_msgs/msg/DiagnosticStatus`` levels."""
+
+RTF_WINDOW = 5.0
+"""Wall-clock seconds over which the achieved real-time factor is measured."""
+
+RTF_TOLERANCE = 0.05
+"""Shortfall of the achieved real-time factor below the requested one that warns (5 %)."""
 
 
 @dataclass(frozen=True)
@@ -138,6 +145,43 @@ class StepMeter:
                           cpu=self._stepping_cpu - cpu0)
 
 
+def merged(windows: Any) -> StepWindow:
+    """Return the sum of consecutive stepping windows (an empty one for none)."""
+    items = list(windows)
+    return StepWindow(wall=sum(w.wall for w in items), simulated=sum(w.simulated for w in items),
+                      steps=sum(w.steps for w in items), stepping=sum(w.stepping for w in items),
+                      cpu=sum(w.cpu for w in items))
+
+
+class SlidingWindow:
+    """
+    The stepping over the last ``span`` wall-clock seconds, from consecutive windows.
+
+    Parameters
+    ----------
+    span : float
+        Wall-clock seconds to cover (the newest windows whose walls add up to at
+        least ``span``, or all since :meth:`clear`).
+
+    """
+
+    def __init__(self, span: float = RTF_WINDOW) -> None:
+        self.span = span
+        self._windows: deque[StepWindow] = deque()
+
+    def add(self, window: StepWindow) -> StepWindow:
+        """Add the newest window; return the stepping over the last ``span`` seconds."""
+        self._windows.append(window)
+        while (len(self._windows) > 1
+               and sum(w.wall for w in self._windows) - self._windows[0].wall >= self.span):
+            self._windows.popleft()
+        return merged(self._windows)
+
+    def clear(self) -> None:
+        """Forget the windows (after a pause or a change of the requested pace)."""
+        self._windows.clear()
+
+
 def passage_level(state: str, divergence: str, bag_error: str, passage: int, target: float,
                   window: StepWindow) -> tuple[int, str]:
     """
@@ -156,7 +200,9 @@ def passage_level(state: str, divergence: str, bag_error: str, passage: int, tar
     target : float
         The requested real-time factor (0: as fast as possible).
     window : StepWindow
-        The stepping since the previous report.
+        The stepping over the measuring window (the last :data:`RTF_WINDOW` seconds):
+        a running passage more than :data:`RTF_TOLERANCE` below the target warns,
+        saying by how much.
 
     """
     rtf = window.real_time_factor
@@ -166,8 +212,11 @@ def passage_level(state: str, divergence: str, bag_error: str, passage: int, tar
         return ERROR, divergence
     if bag_error:
         return ERROR, bag_error
-    if state == 'running' and target > 0 and window.steps and rtf < 0.9 * target:
-        return WARN, f'slower than requested: real-time factor {rtf:.2f} < {target:g}'
+    slow = rtf < (1 - RTF_TOLERANCE) * target
+    if state == 'running' and target > 0 and window.steps and slow:
+        short = 100 * (1 - rtf / target)
+        return WARN, (f'slower than requested: real-time factor {rtf:.2f} over the last '
+                      f'{window.wall:.1f} s < {target:g} ({short:.0f} % short)')
     return OK, f'{state}, passage {passage}'
 
 

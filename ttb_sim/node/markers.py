@@ -79,9 +79,41 @@ CAP_COLOR = (0.50, 0.50, 0.55, 1.0)
 SOIL_COLOR = (0.55, 0.42, 0.28, 0.25)
 
 
-def _girder_depth(scenario: Scenario) -> float:
+def girder_depth(scenario: Scenario) -> float:
     """Return a drawing depth of the girder (m): span/12, at least 0.5 m (display only)."""
     return max(scenario.bridge.span_length / 12.0, 0.5)
+
+
+def _group_origin(scenario: Scenario,
+                  origin: tuple[float, float, float] | None) -> tuple[float, float, float]:
+    """Return the offset of a pile group's own axes: the ground under the pier base."""
+    piles, cap = scenario.piles, scenario.cap
+    if origin is None:
+        return 0.0, 0.0, 0.0
+    # the pier stands on the group centre, the cap on the ground
+    return origin[0] - piles.centre[0], origin[1] - piles.centre[1], origin[2] - cap.thickness
+
+
+def pier_base(scenario: Scenario, pier: int) -> tuple[float, float, float]:
+    """Return the base of a piled pier (the cap top) in the track frame; ``pier`` 1-based."""
+    return ((pier - 1) * scenario.bridge.span_length, 0.0, -scenario.piers.height)
+
+
+def pile_heads(scenario: Scenario, pier: int | None) -> list[tuple[float, float, float]]:
+    """
+    Return the pile-head positions of a pile group, in pile-number order.
+
+    Parameters
+    ----------
+    scenario : Scenario
+        The scenario.
+    pier : int or None
+        The piled pier (1-based support number; the group under its base), or None
+        for a pile-soil substructure alone (its own axes, ground surface z = 0).
+
+    """
+    ox, oy, oz = _group_origin(scenario, None if pier is None else pier_base(scenario, pier))
+    return [(ox + x, oy + y, oz) for x, y in scenario.piles.centres()]
 
 
 def model_markers(scenario: Scenario) -> list[Box]:
@@ -104,7 +136,7 @@ def model_markers(scenario: Scenario) -> list[Box]:
     if scenario.substructure_only:
         return pile_group_markers(scenario)
     b = scenario.bridge
-    depth = _girder_depth(scenario)
+    depth = girder_depth(scenario)
     width = scenario.bearings.spacing + 2.0
     gap = min(0.1, 0.01 * b.span_length)
     boxes = [Box('girders', k, ((k + 0.5) * b.span_length, 0.0, -depth / 2),
@@ -121,7 +153,7 @@ def model_markers(scenario: Scenario) -> list[Box]:
             column = max(height - depth, 0.1)
             boxes.append(Box('piers', s, (x, 0.0, -depth - column / 2),
                              (2.0, 0.6 * width, column), PIER_COLOR))
-            boxes.extend(pile_group_markers(scenario, origin=(x, 0.0, -height),
+            boxes.extend(pile_group_markers(scenario, origin=pier_base(scenario, s + 1),
                                             first_id=100 * s))
         else:
             boxes.append(Box('piers', s, (x, 0.0, -depth - height / 2),
@@ -141,11 +173,7 @@ def pile_group_markers(scenario: Scenario, origin: tuple[float, float, float] | 
     equal-area squares; ids start at ``first_id``.
     """
     piles, soil, cap = scenario.piles, scenario.soil, scenario.cap
-    if origin is None:
-        ox, oy, oz = 0.0, 0.0, 0.0
-    else:  # the pier stands on the group centre, the cap on the ground
-        ox, oy = origin[0] - piles.centre[0], origin[1] - piles.centre[1]
-        oz = origin[2] - cap.thickness
+    ox, oy, oz = _group_origin(scenario, origin)
     w = piles.width
     boxes = [Box('piles', first_id + i, (ox + x, oy + y, oz - piles.length / 2),
                  (w, w, piles.length), PILE_COLOR)

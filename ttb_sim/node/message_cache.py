@@ -39,6 +39,7 @@ from typing import Any, Callable, Sequence
 import numpy as np
 
 from ttb_sim.io.topics import MessageTypes, Topic
+from ttb_sim.node.rates import family_of
 from ttb_sim.sim import Frame
 
 Updater = Callable[[list[float]], None]
@@ -99,6 +100,8 @@ class MessageCache:
         self._index = np.concatenate([t.index for t in self.topics] or [np.zeros(0, np.intp)])
         ends = np.cumsum([len(t.columns) for t in self.topics], dtype=int).tolist()
         self._spans = list(zip([0, *ends[:-1]], ends))
+        self._families = [family_of(t.name) for t in self.topics]
+        self._selections: dict[frozenset[str], list[int]] = {}
 
     def _build(self, frame: Frame) -> None:
         self._header = self._types('std_msgs/msg/Header')(
@@ -132,4 +135,32 @@ class MessageCache:
             else:
                 update(values[start:end])
             out.append(msg)
+        return out
+
+    def due_messages(self, frame: Frame, due: frozenset[str]) -> list[tuple[int, Any]]:
+        """
+        Return ``(topic index, message)`` of the topics whose family is due in ``frame``.
+
+        Only those messages are updated (the others keep their previous frame's
+        values); the same objects come back on the next call, as with :meth:`messages`.
+        """
+        if not self._entries:
+            self._build(frame)
+        selection = self._selections.get(due)
+        if selection is None:
+            selection = [i for i, f in enumerate(self._families) if f in due]
+            self._selections[due] = selection
+        sec, nanosec = divmod(int(frame.stamp_ns), 1_000_000_000)
+        stamp = self._header.stamp
+        stamp.sec, stamp.nanosec = sec, nanosec
+        values = frame.row[self._index].tolist()
+        out = []
+        for i in selection:
+            topic, msg, update = self._entries[i]
+            if update is None:
+                msg = topic.message(self._types, frame)
+            else:
+                start, end = self._spans[i]
+                update(values[start:end])
+            out.append((i, msg))
         return out

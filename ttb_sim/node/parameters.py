@@ -37,19 +37,27 @@ from __future__ import annotations
 from dataclasses import dataclass
 import math
 from pathlib import Path
+import sys
 from typing import Any, Mapping
 
 from ttb_sim.config import apply_overrides, from_mapping, key_spec, Scenario, Spec
 from ttb_sim.errors import ScenarioError
 from ttb_sim.inputs import shown
 from ttb_sim.io.bag import STORAGES
+from ttb_sim.node.rates import RATE_PARAMETERS
 
-DEFAULT_SCENARIO = 'live_train'
+DEFAULT_SCENARIO = 'live_coupled'
 """Scenario loaded when the ``scenario`` parameter is not given."""
 
 SCENARIO_KEYS = ('train.speed_kmh', 'irregularity.spectrum', 'irregularity.seed',
                  'irregularity.file', 'irregularity.scale')
 """Node parameters that are scenario keys (same name, unit, range and description)."""
+
+QOS_RELIABILITIES = ('reliable', 'best_effort')
+"""Values of the ``qos.reliability`` parameter."""
+
+INT64 = (-2 ** 63, 2 ** 63 - 1)
+"""The range of a ROS integer parameter."""
 
 IRREGULARITY_KEYS = tuple(k for k in SCENARIO_KEYS if k.startswith('irregularity.'))
 """The scenario-key parameters that apply from the next passage."""
@@ -126,6 +134,15 @@ _NODE_ONLY: dict[str, tuple[str, Any, Spec, bool]] = {
     'publish_rate_hz': ('double', 50.0, Spec(
         'Hz', 'Rate of live messages in simulation time; 0 publishes every frame (the bag '
         'always gets every frame).', low=0.0, high=10000.0), False),
+    **{name: ('double', 0.0, Spec(
+        'Hz', f'Rate of the live {family}/... topics in simulation time; 0 = publish_rate_hz. '
+        'Rounded to a whole number of output frames; above the output rate is refused.',
+        low=0.0, high=10000.0), False) for name, family in RATE_PARAMETERS.items()},
+    'qos.reliability': ('string', 'reliable', Spec(
+        '-', "Reliability of the data topics: 'reliable' (ros2 bag record and echo get "
+        "every message) or 'best_effort' (rclpy's sensor-data QoS: a slow subscriber "
+        'misses messages instead of holding the publisher up).',
+        choices=QOS_RELIABILITIES), True),
     'real_time_factor': ('double', 1.0, Spec(
         '-', 'Simulated seconds per wall-clock second; 0 = as fast as possible.',
         low=0.0, high=1000.0), False),
@@ -261,6 +278,51 @@ def validate_changes(table: Mapping[str, NodeParameter],
         if not ok:
             return ok, reason
     return True, ''
+
+
+@dataclass(frozen=True)
+class NumericRange:
+    """
+    The closed range (and step) of a numeric parameter, as a ROS descriptor states it.
+
+    ``FloatingPointRange`` / ``IntegerRange`` bounds are inclusive, so an open bound
+    of the schema becomes the next representable value inside it: the speed,
+    refused at 0 km/h, has ``from_value`` 5e-324 (the least positive double), an
+    integer refused at 0 starts at 1. A side without a bound is the largest
+    double or the int64 limit.
+    """
+
+    from_value: float
+    to_value: float
+    step: float
+
+
+def descriptor_range(param: NodeParameter) -> NumericRange | None:
+    """
+    Return the descriptor range of a numeric parameter that has a bound (None otherwise).
+
+    Every value :func:`validate_parameter` accepts lies in the range, and every finite
+    value in it that the schema's range holds is accepted (``test_parameters.py``).
+    """
+    spec = param.spec
+    if param.kind not in ('double', 'integer') or (spec.low is None and spec.high is None):
+        return None
+    if param.kind == 'integer':
+        low = INT64[0] if spec.low is None else math.ceil(spec.low)
+        high = INT64[1] if spec.high is None else math.floor(spec.high)
+        if spec.low is not None and not spec.low_inclusive and low == spec.low:
+            low += 1
+        if spec.high is not None and not spec.high_inclusive and high == spec.high:
+            high -= 1
+        return NumericRange(int(low), int(high), 1)
+    big = sys.float_info.max
+    flow = -big if spec.low is None else float(spec.low)
+    fhigh = big if spec.high is None else float(spec.high)
+    if spec.low is not None and not spec.low_inclusive:
+        flow = math.nextafter(flow, math.inf)
+    if spec.high is not None and not spec.high_inclusive:
+        fhigh = math.nextafter(fhigh, -math.inf)
+    return NumericRange(flow, fhigh, 0.0)
 
 
 def normalize_value(param: NodeParameter, value: Any) -> Any:

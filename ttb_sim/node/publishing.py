@@ -47,11 +47,12 @@ import logging
 import math
 import threading
 import time
-from typing import Callable, Sequence
-
-from ttb_sim.sim import Frame
+from typing import Callable, Generic, Sequence, TypeVar
 
 log = logging.getLogger(__name__)
+
+Item = TypeVar('Item')
+"""What is published: a frame, or a frame with the topic families due in it."""
 
 
 @dataclass(frozen=True)
@@ -83,7 +84,7 @@ class PublishStats:
         return 1e3 * self.busy / self.published if self.published else 0.0
 
 
-class PublishLoop:
+class PublishLoop(Generic[Item]):
     """
     Publish frames on a thread of its own, within a share of the processor.
 
@@ -108,7 +109,7 @@ class PublishLoop:
 
     """
 
-    def __init__(self, publish: Callable[[Sequence[Frame], bool], None], *,
+    def __init__(self, publish: Callable[[Sequence[Item], bool], None], *,
                  duty: float = 0.4, max_backlog: int = 50,
                  clock: Callable[[], float] = time.thread_time, threaded: bool = True,
                  wall: Callable[[], float] = time.monotonic) -> None:
@@ -117,7 +118,7 @@ class PublishLoop:
         self._publish = publish
         self._duty = duty
         self._clock = clock
-        self._frames: deque[Frame] = deque()
+        self._frames: deque[Item] = deque()
         self._max_backlog = max_backlog
         self._markers = False
         self._cond = threading.Condition()
@@ -137,7 +138,7 @@ class PublishLoop:
         if self._threaded:
             self._thread.start()
 
-    def offer(self, frames: Sequence[Frame], markers: bool = False) -> None:
+    def offer(self, frames: Sequence[Item], markers: bool = False) -> None:
         """
         Queue frames for publishing (drops the oldest beyond the backlog).
 
@@ -152,7 +153,7 @@ class PublishLoop:
             return
         self._queue(frames, markers)
 
-    def _queue(self, frames: Sequence[Frame], markers: bool) -> None:
+    def _queue(self, frames: Sequence[Item], markers: bool) -> None:
         with self._cond:
             self._frames.extend(frames)
             self._offered += len(frames)
@@ -163,7 +164,7 @@ class PublishLoop:
             self._markers = self._markers or markers
             self._cond.notify()
 
-    def _offer_inline(self, frames: Sequence[Frame], markers: bool) -> None:
+    def _offer_inline(self, frames: Sequence[Item], markers: bool) -> None:
         if self._stop or self.error:
             return
         if frames or markers:
@@ -188,7 +189,7 @@ class PublishLoop:
         with self._cond:
             return PublishStats(self._offered, self._published, self._dropped, self._busy)
 
-    def _take(self, wait: bool = True) -> tuple[list[Frame], bool] | None:
+    def _take(self, wait: bool = True) -> tuple[list[Item], bool] | None:
         with self._cond:
             while wait and not self._stop and not self._frames and not self._markers:
                 self._cond.wait(0.5)
@@ -204,7 +205,7 @@ class PublishLoop:
             if not self._stop:
                 self._cond.wait_for(lambda: self._stop, timeout=seconds)
 
-    def _publish_batch(self, frames: list[Frame], markers: bool) -> float | None:
+    def _publish_batch(self, frames: list[Item], markers: bool) -> float | None:
         """Publish one batch; return its cost (None: it failed, publishing has ended)."""
         start = self._clock()
         try:

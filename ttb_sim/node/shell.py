@@ -17,18 +17,17 @@ The ROS-free half of the rclpy shell (:mod:`ttb_sim.simulator_node`).
 
 What the shell decides without ROS lives here, so that it is tested where ROS 2 is
 absent: the order of the start-up parameters (the scenario first, then its own),
-the filter that lets a repeating model warning through once, the bag destination
+the QoS profile of each topic, the bag destination
 and the opening of the recorder, the guard that keeps ``/clock`` from going
 backwards, the node's ``/diagnostics`` report (the passage's, or the build's while
 the model is being built, with the publishing counters), the answer of the pause
-service, and the messages the shell logs for passage events and answers while
-building.
+service, the messages the shell logs for passage events and answers while
+building, and the line it logs at shutdown.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
-import logging
 from pathlib import Path
 import threading
 from typing import Any, Callable, Mapping
@@ -43,7 +42,7 @@ from ttb_sim.node.passage import PassageController, Tick
 from ttb_sim.node.publishing import PublishStats
 from ttb_sim.node.runs import FrameSink
 from ttb_sim.node.stepper import StepperStatus
-from ttb_sim.sim import Layout, Simulation
+from ttb_sim.sim import Layout
 
 
 @dataclass(frozen=True)
@@ -84,32 +83,39 @@ def declare_parameters(declare: Callable[[str, Any, NodeParameter], Any]) -> Sta
     return StartUp(scenario, table, given, initial_values(table, given))
 
 
-class OnceFilter(logging.Filter):
-    """Let each distinct log message through once (a model warning, not once per passage)."""
+QOS_CLASSES = {'sensor': None, 'clock': 'clock', 'latched': 'latched'}
+"""The node's QoS class of each topic-table ``qos`` name (None: ``qos.reliability``).
 
-    def __init__(self) -> None:
-        super().__init__()
-        self._seen: set[str] = set()
-
-    def filter(self, record: logging.LogRecord) -> bool:  # noqa: A003 - logging API
-        """Return True the first time a message is seen."""
-        message = record.getMessage()
-        if message in self._seen:
-            return False
-        self._seen.add(message)
-        return True
+The topic table (:mod:`ttb_sim.io.topics`) calls its data topics' class 'sensor', but
+they are RELIABLE by default, unlike rclpy's ``qos_profile_sensor_data`` (best effort):
+the node names its profiles by what they are, 'reliable' and 'best_effort', and the
+parameter ``qos.reliability`` chooses between them for the data topics.
+"""
 
 
-ONCE_LOGGERS = (Simulation.__module__,)
-"""Loggers of the model whose warnings repeat with every passage (each builds the model)."""
+def qos_class(topic_qos: str, reliability: str) -> str:
+    """
+    Return the node's QoS profile name of a topic-table QoS class.
 
+    Parameters
+    ----------
+    topic_qos : str
+        The topic's ``qos`` ('sensor', 'clock' or 'latched').
+    reliability : str
+        The ``qos.reliability`` parameter ('reliable' or 'best_effort').
 
-def quiet_repeated_warnings() -> None:
-    """Give every logger of :data:`ONCE_LOGGERS` one :class:`OnceFilter` (idempotent)."""
-    for name in ONCE_LOGGERS:
-        logger = logging.getLogger(name)
-        if not any(isinstance(f, OnceFilter) for f in logger.filters):
-            logger.addFilter(OnceFilter())
+    Returns
+    -------
+    str
+        'reliable', 'best_effort', 'clock' or 'latched'.
+
+    """
+    try:
+        fixed = QOS_CLASSES[topic_qos]
+    except KeyError:
+        raise ValueError(f'unknown topic QoS class {topic_qos!r}; known: '
+                         f'{", ".join(QOS_CLASSES)}') from None
+    return reliability if fixed is None else fixed
 
 
 def bag_destination(values: Mapping[str, Any], scenario_name: str) -> Path | None:
@@ -223,3 +229,30 @@ def node_diagnostics(scenario_name: str, status: StepperStatus,
         if publish_error:
             level, message = ERROR, publish_error
     return DiagnosticsReport(level, message, tuple(values))
+
+
+def shutdown_line(controller: PassageController | None, published: int,
+                  bag: Path | None) -> str:
+    """
+    Return the line the node logs at shutdown: what ran.
+
+    Parameters
+    ----------
+    controller : PassageController or None
+        The passage controller (None: the model was never built).
+    published : int
+        Frames published live.
+    bag : Path or None
+        The bag directory when recording.
+
+    """
+    if controller is None:
+        return 'shutting down before the model was built; nothing was simulated' + (
+            f' (no bag was opened at {bag})' if bag is not None else '')
+    line = (f'shutting down: {controller.passage} passage(s), '
+            f'{controller.simulated:.2f} s simulated (node time {controller.node_time:.2f} s), '
+            f'real-time factor {controller.run_real_time_factor():.3f} over the run, '
+            f'{published} frames published')
+    if bag is not None:
+        line += f', {controller.recorded} frames recorded to {bag}'
+    return line

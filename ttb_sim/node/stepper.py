@@ -193,9 +193,10 @@ class Stepper:
     def _fail(self, message: str, code: int) -> None:
         with self._lock:
             self._state, self._error = 'failed', message
-        log.error(message)
-        if self._on_failed is not None:
+        if self._on_failed is not None:   # it reports the failure (the node: one FATAL line)
             self._on_failed(message, code)
+        else:
+            log.error(message)
 
     def _run(self) -> None:
         controller = self._build()
@@ -223,7 +224,7 @@ class Stepper:
 
     def _build(self) -> PassageController | None:
         """Build the controller and open the recorder; None on failure or stop."""
-        log.info('building model: %s', self.scenario.name)
+        log.debug('building model: %s', self.scenario.name)
         try:
             with self._lock:
                 values = dict(self.values)
@@ -252,7 +253,7 @@ class Stepper:
             self.controller = controller
             self._build_time = self._clock() - self._started
             self._state = 'waiting'
-        log.info('model built in %.2f s', self._build_time)
+        log.debug('model built in %.2f s', self._build_time)
         if self._on_built is not None:
             self._on_built(controller)
         return controller
