@@ -85,7 +85,7 @@ from ttb_sim.node import (markers, NodeParameter, PassageController, validate_ch
                           validate_parameter)
 from ttb_sim.node.diagnostics import diagnostic_array
 from ttb_sim.node.frames_tf import static_frames, tf_message
-from ttb_sim.node.logs import ForwardingHandler, install
+from ttb_sim.node.logs import ForwardingHandler, install, ProgressWatcher
 from ttb_sim.node.markers import marker_array
 from ttb_sim.node.message_cache import MessageCache
 from ttb_sim.node.parameters import descriptor_range, NumericRange
@@ -247,6 +247,8 @@ class SimulatorNode(Node):
         self._restore_blas = hold_blas_threads()   # before any numpy work of the model
         self._log_handler = ForwardingHandler(self._forward_log)
         self._uninstall_log = install(self._log_handler)
+        self._progress = ProgressWatcher()
+        self._uninstall_progress = install(self._progress)
         try:
             self._configure()
         except BaseException:   # a bad value, or Ctrl-C in the middle of the set-up
@@ -514,7 +516,8 @@ class SimulatorNode(Node):
         report = node_diagnostics(self.scenario.name, status,
                                   controller.diagnostics() if controller is not None else None,
                                   loop.stats() if loop is not None else None,
-                                  loop.error if loop is not None else '')
+                                  loop.error if loop is not None else '',
+                                  self._progress.latest)
         # Simulation time, like every data topic (0 while the model is being built).
         sim_ns = round(controller.node_time * 1e9) if controller is not None else 0
         sec, nanosec = divmod(sim_ns, 1_000_000_000)
@@ -540,6 +543,7 @@ class SimulatorNode(Node):
         if self.stepper is not None:
             published = self.publish_loop.stats().published if self.publish_loop else 0
             logger.info(shutdown_line(self.controller, published, self._bag_path))
+        self._uninstall_progress()   # before the forwarding handler: it restores the logger
         self._uninstall_log()
         if self._restore_blas is not None:
             self._restore_blas()

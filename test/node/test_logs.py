@@ -103,3 +103,26 @@ def test_records_reach_the_sink_only_and_uninstall_restores_the_logger(capsys):
     assert sink.lines == [('warning', 'forwarded')]
     assert 'after shutdown' in capsys.readouterr().err
     assert (logger.level, logger.propagate, list(logger.handlers)) == before
+
+
+def test_the_progress_watcher_keeps_the_last_build_progress_for_the_diagnostics():
+    """A reduction's per-shift record reaches /diagnostics' build report with its percent."""
+    from ttb_sim.model.foundation.reduction import BuildProgress
+    from ttb_sim.node.logs import install, ProgressWatcher
+    from ttb_sim.node.shell import node_diagnostics
+    from ttb_sim.node.stepper import StepperStatus
+    watcher = ProgressWatcher()
+    undo = install(watcher)
+    try:
+        progress = BuildProgress(5, 600.0)
+        progress(2)
+    finally:
+        undo()
+    assert watcher.latest is not None
+    fraction, left, line = watcher.latest
+    assert fraction == 0.4 and left is not None and '2 of 5 shifts done (40 %)' in line
+    report = node_diagnostics('paper_ttbcpsi', StepperStatus('building', 12.0), None,
+                              progress=watcher.latest)
+    values = dict(report.values)
+    assert values['substructure reduction done (%)'] == '40'
+    assert '40 %' in report.message

@@ -50,8 +50,8 @@ def test_a_scenario_that_does_not_load_is_a_scenario_error():
 
 
 def test_qos_classes_say_what_they_are():
-    assert qos_class('sensor', 'reliable') == 'reliable'
-    assert qos_class('sensor', 'best_effort') == 'best_effort'
+    assert qos_class('data', 'reliable') == 'reliable'
+    assert qos_class('data', 'best_effort') == 'best_effort'
     assert qos_class('clock', 'best_effort') == 'clock'
     assert qos_class('latched', 'best_effort') == 'latched'
     with pytest.raises(ValueError, match='unknown topic QoS class'):

@@ -170,7 +170,8 @@ class Topic:
     build : callable
         (types, stamp_ns, values) -> message.
     qos : str
-        'sensor' (reliable, keep last 10), 'clock' or 'latched'.
+        'data' (the data topics: the node publishes them reliable or best effort, as its
+        ``qos.reliability`` says), 'clock' or 'latched'.
     unit : str
         Unit of the values, for documentation.
 
@@ -181,7 +182,7 @@ class Topic:
     fields: tuple[str, ...]
     columns: tuple[int, ...]
     build: Callable[[MessageTypes, int, np.ndarray], Any]
-    qos: str = 'sensor'
+    qos: str = 'data'
     unit: str = ''
 
     def full_name(self, namespace: str = NAMESPACE) -> str:

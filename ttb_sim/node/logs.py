@@ -124,6 +124,30 @@ class ForwardingHandler(logging.Handler):
             self.handleError(record)
 
 
+PROGRESS_FIELD = 'build_progress'
+"""The attribute a long build's progress records carry (``reduction.PROGRESS_FIELD``)."""
+
+
+class ProgressWatcher(logging.Handler):
+    """
+    Keep the last progress record of a long build: (fraction, seconds left, message).
+
+    The pile-soil reduction logs one per shift with ``build_progress`` attached
+    (:class:`ttb_sim.model.foundation.reduction.BuildProgress`); the node shows the
+    last one on ``/diagnostics`` while it builds.
+    """
+
+    def __init__(self) -> None:
+        super().__init__(logging.DEBUG)
+        self.latest: tuple[float, float | None, str] | None = None
+
+    def emit(self, record: logging.LogRecord) -> None:
+        """Remember a progress record (others are ignored)."""
+        progress = getattr(record, PROGRESS_FIELD, None)
+        if progress is not None:
+            self.latest = (float(progress[0]), progress[1], record.getMessage())
+
+
 def install(handler: logging.Handler, name: str = 'ttb_sim',
             level: int = logging.INFO) -> Callable[[], None]:
     """

@@ -83,13 +83,13 @@ def declare_parameters(declare: Callable[[str, Any, NodeParameter], Any]) -> Sta
     return StartUp(scenario, table, given, initial_values(table, given))
 
 
-QOS_CLASSES = {'sensor': None, 'clock': 'clock', 'latched': 'latched'}
+QOS_CLASSES = {'data': None, 'clock': 'clock', 'latched': 'latched'}
 """The node's QoS class of each topic-table ``qos`` name (None: ``qos.reliability``).
 
-The topic table (:mod:`ttb_sim.io.topics`) calls its data topics' class 'sensor', but
-they are RELIABLE by default, unlike rclpy's ``qos_profile_sensor_data`` (best effort):
-the node names its profiles by what they are, 'reliable' and 'best_effort', and the
-parameter ``qos.reliability`` chooses between them for the data topics.
+The topic table (:mod:`ttb_sim.io.topics`) calls its data topics' class 'data': the node
+names its profiles by what they are, 'reliable' (the default, so ``ros2 bag record`` and
+``ros2 topic echo`` get every message) and 'best_effort' (as rclpy's
+``qos_profile_sensor_data``), and the parameter ``qos.reliability`` chooses between them.
 """
 
 
@@ -100,7 +100,7 @@ def qos_class(topic_qos: str, reliability: str) -> str:
     Parameters
     ----------
     topic_qos : str
-        The topic's ``qos`` ('sensor', 'clock' or 'latched').
+        The topic's ``qos`` ('data', 'clock' or 'latched').
     reliability : str
         The ``qos.reliability`` parameter ('reliable' or 'best_effort').
 
@@ -191,7 +191,9 @@ def tick_messages(tick: Tick, controller: PassageController | None) -> list[tupl
 
 def node_diagnostics(scenario_name: str, status: StepperStatus,
                      passage: DiagnosticsReport | None, publishing: PublishStats | None = None,
-                     publish_error: str = '') -> DiagnosticsReport:
+                     publish_error: str = '',
+                     progress: tuple[float, float | None, str] | None = None
+                     ) -> DiagnosticsReport:
     """
     Return the node's ``/diagnostics`` report.
 
@@ -207,6 +209,9 @@ def node_diagnostics(scenario_name: str, status: StepperStatus,
         The publishing counters, once publishing has started.
     publish_error : str
         Why publishing stopped ('' if it did not).
+    progress : (fraction, seconds left or None, message), optional
+        The last progress line of a long build (the pile-soil reduction), shown
+        while the model is being built.
 
     """
     if passage is None:
@@ -216,6 +221,12 @@ def node_diagnostics(scenario_name: str, status: StepperStatus,
             level, message = OK, f'building model: {status.elapsed:.1f} s'
         values = [('state', status.state), ('scenario', scenario_name),
                   ('build time so far (s)', f'{status.elapsed:.1f}')]
+        if progress is not None and status.state != 'failed':
+            fraction, left, line = progress
+            values += [('substructure reduction done (%)', f'{100 * fraction:.0f}'),
+                       ('substructure reduction CPU time left (s)',
+                        f'{left:.0f}' if left is not None else 'unknown'), ('progress', line)]
+            message += f' ({line})'
         return DiagnosticsReport(level, message, tuple(values))
     level, message = passage.level, passage.message
     values = list(passage.values)

@@ -101,6 +101,11 @@ def build_seconds(dofs: int, shifts: int) -> float:
     return SHIFT_SECONDS * shifts * (dofs / SHIFT_DOFS) ** SHIFT_EXPONENT
 
 
+PROGRESS_FIELD = 'build_progress'
+"""Attribute of a progress record: (fraction done, CPU seconds left or None), for a watcher
+such as the node's ``/diagnostics`` (:class:`ttb_sim.node.logs.ProgressWatcher`)."""
+
+
 class BuildProgress:
     """
     Report a reduction's progress, shift by shift: percent done, CPU so far, time left.
@@ -130,7 +135,8 @@ class BuildProgress:
             f', about {_duration(self.remaining)} left')
         LOG.log(self.level, 'reducing the pile-soil substructure: %d of %d shifts done '
                 '(%.0f %%), %s of CPU so far%s', done, self.total, 100 * self.fraction,
-                _duration(spent), left)
+                _duration(spent), left,
+                extra={PROGRESS_FIELD: (self.fraction, self.remaining)})
 
 
 def _duration(seconds: float) -> str:
