@@ -22,8 +22,9 @@ Inside numba, ``np.linalg.solve`` costs about 5 s of compilation on a cold
 cache (its LAPACK binding, shape checks and error messages), more than the
 rest of the quarter-car loop together; these loops compile in a fraction of a
 second. It is meant for the few-by-few systems of the wheel couplings (one
-row per axle); the numpy paths keep ``np.linalg.solve`` and serve as its test
-oracle (to round-off: the order of the operations differs).
+row per axle: the quarter cars' Woodbury system, each car's contact Newton
+step); the numpy paths keep ``np.linalg.solve`` and serve as its test oracle
+(to round-off: the order of the operations differs).
 """
 
 from __future__ import annotations
@@ -49,7 +50,7 @@ def solve_in_place(a: np.ndarray, b: np.ndarray) -> bool:
         if largest == 0.0:
             return False
         if pivot != k:
-            for j in range(n):
+            for j in range(k, n):   # left of k: multipliers never read again
                 a[k, j], a[pivot, j] = a[pivot, j], a[k, j]
             b[k], b[pivot] = b[pivot], b[k]
         inverse = 1.0 / a[k, k]

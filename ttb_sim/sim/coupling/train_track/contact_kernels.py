@@ -35,11 +35,12 @@ import math
 
 import numpy as np
 
+from ttb_sim.fe.dense_kernels import solve_in_place
 from ttb_sim.model.wheel_rail.creep import CREEP_LOAD_EXPONENTS
 from ttb_sim.sim.coupling.train_track.rail_kernels import COMPONENTS, wheel_force_products
 
 HELPERS = ('_car_motion', '_interp', '_interval', '_sensitivities', '_she_factor',
-           '_solve_in_place', '_wheel_equations', '_wheel_geometry', 'wheel_force_products')
+           'solve_in_place', '_wheel_equations', '_wheel_geometry', 'wheel_force_products')
 """Functions the kernels call: :func:`ttb_sim.fe.compiled.jit` compiles them first."""
 
 
@@ -229,7 +230,8 @@ def contact_newton(g: np.ndarray, w0: np.ndarray, wv0: np.ndarray, r0p: np.ndarr
                     c, k, s, g, w, wv, r, rv, delta, radius[0], angle[0], tan_slope,
                     irr_dy[c, k], creep, d_delta, d_yrel, d_xi_x, d_xi_y, d_xi_sp, r0, g_hertz,
                     g15, friction, speed, a, b)
-            _solve_in_place(a, b)
+            if not solve_in_place(a, b):
+                b[:] = np.nan   # a singular Newton system: the divergence check stops the run
             for j in range(m):
                 g[c, j] += b[j]
             for k in range(n_wheels):
@@ -420,35 +422,3 @@ def _interval(y: float, grid: np.ndarray) -> int:
     if y >= grid[grid.shape[0] - 1]:
         return grid.shape[0] - 1
     return int(np.searchsorted(grid, y, side='right')) - 1
-
-
-def _solve_in_place(a: np.ndarray, b: np.ndarray) -> None:
-    """Overwrite b with a^-1 b (Gaussian elimination, partial pivoting); a is destroyed."""
-    n = b.shape[0]
-    for col in range(n):
-        pivot = col
-        best = abs(a[col, col])
-        for i in range(col + 1, n):
-            if abs(a[i, col]) > best:
-                best = abs(a[i, col])
-                pivot = i
-        if pivot != col:
-            for j in range(col, n):
-                tmp = a[col, j]
-                a[col, j] = a[pivot, j]
-                a[pivot, j] = tmp
-            tmp = b[col]
-            b[col] = b[pivot]
-            b[pivot] = tmp
-        inv = 1.0 / a[col, col]
-        for i in range(col + 1, n):
-            factor = a[i, col] * inv
-            if factor != 0.0:
-                for j in range(col + 1, n):
-                    a[i, j] -= factor * a[col, j]
-                b[i] -= factor * b[col]
-    for i in range(n - 1, -1, -1):
-        acc = b[i]
-        for j in range(i + 1, n):
-            acc -= a[i, j] * b[j]
-        b[i] = acc / a[i, i]
