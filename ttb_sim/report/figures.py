@@ -37,11 +37,10 @@ from ttb_sim.analysis.psd import resolving_segment_seconds, welch_psd
 from ttb_sim.analysis.rigid_displacement import rigid_midspan_displacement
 from ttb_sim.analysis.safety import deck_acceleration
 from ttb_sim.io.streams import Series, Streams
-from ttb_sim.report.metrics import (bag_metrics, CAR_BODY_LOWEST_HZ, ground_grid_rms, marks_of,
-                                    observer_stations,
-                                    pier_power_flows, power_flows, soil_line,
-                                    soil_val_points)
+from ttb_sim.report.metrics import (bag_metrics, CAR_BODY_LOWEST_HZ, marks_of, observer_stations,
+                                    pier_power_flows, power_flows)
 from ttb_sim.report.output import FigureNote
+from ttb_sim.report.soil import ground_grid_rms, soil_line, soil_val_points
 
 log = logging.getLogger(__name__)
 
@@ -290,15 +289,8 @@ def pier_power_flow(bags: Sequence[Streams], out: Path) -> FigureNote:
     panels = []
     for pier in sorted(set().union(*(f for _, f in flows))):
         piled = any(pier in _piled(s) for s, _ in flows)
-        traces, total = [], []
-        for s, f in flows:
-            if pier in f:
-                freq, p = f[pier]
-                traces.append((s.label, freq[1:], np.abs(p[1:])))
-                total.append(f'{p.sum():.3g}')
-        panels.append(Panel(f'pier{pier:02d} ({"piled" if piled else "springs"}): mean '
-                            f'{" / ".join(total)} W', 'frequency f (Hz)', '|P(f)| per line (W)',
-                            traces, logy=True, xlim=(0.0, 50.0), marks=marks))
+        panels.append(_power_panel(f'pier{pier:02d} ({"piled" if piled else "springs"})', 'W',
+                                   [(s.label, f[pier]) for s, f in flows if pier in f], marks))
     rows = [panels[i:i + 3] for i in range(0, len(panels), 3)]
     path = panels_figure(out / 'power_flow.png', 'Vibration power flow into the piers through '
                          'their bearings ([P] Eqs. 17-18)', rows)
@@ -307,6 +299,16 @@ def pier_power_flow(bags: Sequence[Streams], out: Path) -> FigureNote:
                       'and piers on foundation springs side by side (the rocking power of the '
                       'bearing pair is not recorded). Magnitudes on a log axis; the titles give '
                       'the time-mean power (the sum of the lines).')
+
+
+def _power_panel(title: str, unit: str,
+                 spectra: Sequence[tuple[str, tuple[np.ndarray, np.ndarray]]],
+                 marks: Sequence[Excitation]) -> Panel:
+    """Return a panel of power-flow magnitudes per line, one trace per bag, means in the title."""
+    traces = [(label, freq[1:], np.abs(p[1:])) for label, (freq, p) in spectra]
+    means = ' / '.join(f'{p.sum():.3g}' for _, (_, p) in spectra)
+    return Panel(f'{title}: mean {means} {unit}', 'frequency f (Hz)',
+                 f'|P(f)| per line ({unit})', traces, logy=True, xlim=(0.0, 50.0), marks=marks)
 
 
 def _piled(s: Streams) -> set[int]:
@@ -325,16 +327,9 @@ def power_flow(bags: Sequence[Streams], out: Path) -> FigureNote:
     panels = []
     for station in stations:
         for layer in _LAYERS:
-            traces = []
-            total = []
-            for s, f in flows:
-                if station in f:
-                    freq, p = f[station][layer]
-                    traces.append((s.label, freq[1:], np.abs(p[1:])))
-                    total.append(f'{p.sum():.3g}')
-            panels.append(Panel(f'{layer} at {station}: mean {" / ".join(total)} W/m',
-                                'frequency f (Hz)', '|P(f)| per line (W/m)', traces,
-                                logy=True, xlim=(0.0, 50.0), marks=marks))
+            panels.append(_power_panel(f'{layer} at {station}', 'W/m',
+                                       [(s.label, f[station][layer]) for s, f in flows
+                                        if station in f], marks))
     rows = [panels[i:i + 2] for i in range(0, len(panels), 2)]
     path = panels_figure(out / 'power_flow.png', 'Vibration power flow per layer ([P] Eqs. '
                          '17-18, Figs. 18-19)', rows)
