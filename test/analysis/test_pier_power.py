@@ -85,7 +85,7 @@ def test_the_ground_grid_map_reads_the_named_points_into_rows_and_columns(tmp_pa
     """A 2 x 3 grid of pier07 after one line point: x, y axes and RMS az in (row, column)."""
     from ttb_sim.io.topics import SOIL_FIELDS
     from ttb_sim.report.figures import soil_grid
-    from ttb_sim.report.metrics import ground_grid_rms
+    from ttb_sim.report.soil import ground_grid_rms
     t = np.arange(0, 1.0, 0.01)
     names = ('pier07/line_01', *(f'pier07/grid_{r:02d}_{c:02d}' for r in (1, 2)
                                  for c in (1, 2, 3)))

@@ -17,23 +17,22 @@ Metrics of bags, shared by ``ttb-sim analyze`` (one bag), ``compare`` (several) 
 
 :func:`bag_metrics` computes the numbers of one :class:`~ttb_sim.io.streams.Streams`
 (written to ``metrics.json``); the stream pickers beside it (excitation marks, the
-soil observation line and VAL points, the observer stations and their power flow)
-are shared with :mod:`ttb_sim.report.figures`; :func:`flatten` and
-:func:`differences` give the table of ``compare``.  The physics lives in
+observer stations and their power flow, the power into the piers) are shared with
+:mod:`ttb_sim.report.figures` (those of the ground points are in
+:mod:`ttb_sim.report.soil`); :func:`flatten` and :func:`differences` give the table of
+``compare``.  The physics lives in
 :mod:`ttb_sim.analysis`; this module only picks the streams and lays them out.
 """
 
 from __future__ import annotations
 
 import logging
-import math
 import re
 from typing import Any, Sequence
 
 import numpy as np
 
 from ttb_sim.analysis.excitation import Excitation, excitation_frequencies
-from ttb_sim.analysis.levels import total_level, vibration_levels
 from ttb_sim.analysis.power_flow import power_flow_spectrum, velocity_from_displacement
 from ttb_sim.analysis.psd import (level_change_frequency, peak_frequency,
                                   resolving_segment_seconds, welch_psd)
@@ -42,6 +41,7 @@ from ttb_sim.analysis.safety import (deck_acceleration, derailment_coefficient,
                                      lateral_force_limit, LIMITS, wheel_load_reduction)
 from ttb_sim.analysis.weighting import weighted_rms
 from ttb_sim.io.streams import Series, Streams
+from ttb_sim.report.soil import soil_metrics
 
 log = logging.getLogger(__name__)
 
@@ -208,7 +208,7 @@ def bag_metrics(s: Streams) -> dict[str, Any]:
     if s.pile_acceleration or s.pile_displacement:
         out['piles'] = _pile_metrics(s)
     if s.soil is not None:
-        out['soil'] = _soil_metrics(s)
+        out['soil'] = soil_metrics(s)
     flows = power_flows(s)
     if flows:
         out['power_flow_mean_W_per_m'] = {
@@ -294,115 +294,6 @@ def _pile_metrics(s: Streams) -> dict[str, Any]:
             entry['horizontal_displacement_peak_m'] = float(np.max(np.hypot(d[:, 0], d[:, 1])))
         piles[f'pier{key[0]:02d}_pile{key[1]:02d}'] = entry
     return piles
-
-
-def _soil_xyz(s: Streams) -> np.ndarray | None:
-    if s.soil is None or not all(c in s.soil_fields for c in ('x', 'y', 'z', 'az')):
-        return None
-    return np.stack([s.soil.values[0, :, s.soil_fields.index(c)] for c in ('x', 'y', 'z')],
-                    axis=-1).astype(float)
-
-
-def soil_line(s: Streams) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
-    """
-    Return (point indices, distance along the line (m), az (n, points)) of the observation line.
-
-    The first piled pier's ``line_`` points where summary.json names the points;
-    else the points from the first one on that share its y and z (to 1 mm), in
-    the order written: ttb_sim writes [P]'s observation line first, then the VAL
-    points, the user's points and the ground grid. Ordered by x.
-    """
-    xyz = _soil_xyz(s)
-    if xyz is None or s.soil is None:
-        return None
-    if s.soil_names:
-        first = s.soil_names[0].split('/')[0]
-        on = np.array([i for i, n in enumerate(s.soil_names)
-                       if n.startswith(f'{first}/line_')], dtype=np.intp)
-    else:
-        same = ((np.abs(xyz[:, 1] - xyz[0, 1]) < 1e-3) & (np.abs(xyz[:, 2] - xyz[0, 2]) < 1e-3))
-        on = np.arange(int(np.argmin(same)) if not same.all() else same.size)
-    if on.size == 0:
-        on = np.arange(1)
-    order = on[np.argsort(xyz[on, 0], kind='stable')]
-    distance = xyz[order, 0] - xyz[order[0], 0]
-    return order, distance, s.soil.values[:, order, s.soil_fields.index('az')]
-
-
-def ground_grid_rms(s: Streams) -> dict[str, tuple[np.ndarray, np.ndarray, np.ndarray]]:
-    """
-    Return, per piled pier, its ground grid's x (nx,), y (ny,) and RMS az (ny, nx) (m, m/s^2).
-
-    The points named ``pierNN/grid_RR_CC`` in summary.json (rows along y, x fastest);
-    {} without names or grid.
-    """
-    xyz = _soil_xyz(s)
-    if xyz is None or s.soil is None or not s.soil_names:
-        return {}
-    az = s.soil.values[:, :, s.soil_fields.index('az')]
-    rms = np.sqrt(np.mean(az ** 2, axis=0))
-    out: dict[str, tuple[np.ndarray, np.ndarray, np.ndarray]] = {}
-    piers = sorted({n.split('/')[0] for n in s.soil_names if '/grid_' in n})
-    for pier in piers:
-        idx = np.array([i for i, n in enumerate(s.soil_names) if n.startswith(f'{pier}/grid_')])
-        rows = max(int(s.soil_names[i].split('_')[-2]) for i in idx)
-        if idx.size % rows:
-            continue
-        shape = (rows, idx.size // rows)
-        out[pier] = (xyz[idx, 0].reshape(shape)[0], xyz[idx, 1].reshape(shape)[:, 0],
-                     rms[idx].reshape(shape))
-    return out
-
-
-VAL_POINTS_UNNAMED = 6
-"""Points rated by VAL in a cloud without names: the first ones after the line."""
-
-
-def soil_val_points(s: Streams) -> list[tuple[str, np.ndarray]]:
-    """
-    Return (label, vertical acceleration record) of the ground points to rate by VAL.
-
-    Where summary.json names the points: every pier's [P] section 4.2.2 VAL
-    points and the user's points (not the ground grid). Without names: the
-    first :data:`VAL_POINTS_UNNAMED` points after the observation line. Where
-    there are none, the first, middle and last point of the line.
-    """
-    xyz = _soil_xyz(s)
-    line = soil_line(s)
-    if xyz is None or line is None or s.soil is None:
-        return []
-    az = s.soil.values[:, :, s.soil_fields.index('az')]
-    on_line = set(line[0].tolist())
-    if s.soil_names:
-        off = [i for i, n in enumerate(s.soil_names)
-               if n.split('/')[-1].startswith(('val_', 'user_'))]
-    else:
-        off = [i for i in range(xyz.shape[0]) if i not in on_line][:VAL_POINTS_UNNAMED]
-    if off:
-        return [(f'point ({xyz[i, 0]:.1f}, {xyz[i, 1]:.1f}) m', az[:, i]) for i in off]
-    order, distance, _ = line
-    n = order.size
-    return [(f'line point at {distance[k]:.1f} m', az[:, order[k]])
-            for k in sorted({0, n // 2, n - 1})]
-
-
-def _soil_metrics(s: Streams) -> dict[str, Any]:
-    line = soil_line(s)
-    if line is None or s.soil is None:
-        return {}
-    fs = s.soil.rate
-    points = {}
-    for label, record in soil_val_points(s):
-        centres, val = vibration_levels(record, fs)
-        points[label.replace(' ', '_')] = {
-            'vertical_acceleration_peak_m_s2': float(np.max(np.abs(record))),
-            'val_band_centres_hz': [float(c) for c in centres],
-            'val_db': [float(v) if math.isfinite(v) else None for v in val],
-            'val_max_db': float(np.max(val)), 'val_max_band_hz': float(centres[np.argmax(val)]),
-            'vl_total_db': total_level(centres, val),
-            'vl_wk_db': total_level(centres, val, 'Wk'),
-            'vl_wm_db': total_level(centres, val, 'Wm')}
-    return {'line_peak_acceleration_m_s2': float(np.max(np.abs(line[2]))), 'points': points}
 
 
 # -- power flow --------------------------------------------------------------------------
