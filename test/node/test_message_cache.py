@@ -31,14 +31,19 @@ from ttb_sim.node.message_cache import MessageCache
 from ttb_sim.sim import make_runner
 
 
-def test_cached_messages_serialise_like_fresh_ones():
-    """Every message of every frame has the bytes of one built from scratch."""
+def _cache(n_frames: int):
+    """Return live_train's first frames, the typestore, its types, the topics and a cache."""
     sim = make_runner(load_scenario('live_train'))
-    frames = list(itertools.islice(sim.frames(), 40))
+    frames = list(itertools.islice(sim.frames(), n_frames))
     store = typestore()
     types = store.types.__getitem__
     topics = [t for t in topic_table(sim.layout) if t.qos != 'clock']
-    cache = MessageCache(topics, types)
+    return frames, store, types, topics, MessageCache(topics, types)
+
+
+def test_cached_messages_serialise_like_fresh_ones():
+    """Every message of every frame has the bytes of one built from scratch."""
+    frames, store, types, topics, cache = _cache(40)
     changed = set()
     previous: dict[str, bytes] = {}
     for frame in frames:
@@ -56,12 +61,7 @@ def test_cached_messages_serialise_like_fresh_ones():
 
 def test_due_messages_are_those_of_the_due_families_and_fresh():
     """Only the due families' topics come back, each with the bytes of a fresh message."""
-    sim = make_runner(load_scenario('live_train'))
-    frames = list(itertools.islice(sim.frames(), 6))
-    store = typestore()
-    types = store.types.__getitem__
-    topics = [t for t in topic_table(sim.layout) if t.qos != 'clock']
-    cache = MessageCache(topics, types)
+    frames, store, types, topics, cache = _cache(6)
     for k, frame in enumerate(frames):
         due = frozenset({'wheel_rail'} if k % 2 else {'wheel_rail', 'bridge'})
         got = cache.due_messages(frame, due)
