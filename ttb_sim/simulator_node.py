@@ -74,7 +74,8 @@ from rclpy.executors import ExternalShutdownException, MultiThreadedExecutor
 from rclpy.logging import get_logger
 from rclpy.node import Node
 from rclpy.parameter import Parameter
-from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
+from rclpy.qos import (DurabilityPolicy, HistoryPolicy, qos_profile_sensor_data, QoSProfile,
+                       ReliabilityPolicy)
 from rclpy.task import Future
 from rosgraph_msgs.msg import Clock as ClockMsg
 from rosidl_runtime_py.utilities import get_message
@@ -114,10 +115,7 @@ QOS = {
     'reliable': QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=10,
                            reliability=ReliabilityPolicy.RELIABLE,
                            durability=DurabilityPolicy.VOLATILE),
-    # rclpy's qos_profile_sensor_data, spelled out
-    'best_effort': QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=5,
-                              reliability=ReliabilityPolicy.BEST_EFFORT,
-                              durability=DurabilityPolicy.VOLATILE),
+    'best_effort': qos_profile_sensor_data,   # rclpy's: best effort, keep last 5
     'clock': QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=1,
                         reliability=ReliabilityPolicy.RELIABLE,
                         durability=DurabilityPolicy.VOLATILE),
