@@ -21,6 +21,7 @@ References and tolerances are stated per test; exact ones are to round-off.
 import numpy as np
 import pytest
 
+from ttb_sim.errors import FEError
 from ttb_sim.fe import hex8
 from ttb_sim.fe.assembly import assemble_chunked
 from ttb_sim.fe.boundary import boundary_matrix, face_matrices
@@ -150,3 +151,25 @@ def test_boundary_lumped_and_consistent_totals():
         assert k.sum() == pytest.approx(6 * 7.0, rel=1e-12)
     m = face_matrices(nodes[None], np.array([5.0]), np.array([1.0]), 'lumped')[0]
     assert np.allclose(m[:3, :3], 1.5 * np.diag([5.0, 1.0, 1.0]))
+
+
+def test_a_unit_stretch_changes_nothing_and_a_complex_one_keeps_symmetry() -> None:
+    rng = np.random.default_rng(7)
+    coords = np.repeat(hex8.CORNERS[None] * np.array([0.5, 0.7, 0.3]), 3, axis=0) \
+        + rng.normal(0.0, 0.02, (3, 8, 3))
+    young, poisson = np.array([1e6, 2e6, 3e6]), np.array([0.25, 0.3, 0.35])
+    plain = hex8.stiffness(coords, young, poisson)
+    assert np.array_equal(hex8.stiffness(coords, young, poisson, np.ones((3, 8, 3))), plain)
+    s = 1.0 + rng.normal(0.0, 0.3, (3, 8, 3)) - 1j * rng.uniform(0.0, 2.0, (3, 8, 3))
+    k = hex8.stiffness(coords, young, poisson, s)
+    # the fast kernel against the explicit-B one; transposes, not conjugates: Z = Z^T
+    np.testing.assert_allclose(k, hex8.stiffness_reference(coords, young, poisson, s),
+                               rtol=0, atol=1e-12 * np.abs(k).max())
+    np.testing.assert_allclose(k, np.swapaxes(k, 1, 2), rtol=0, atol=1e-12 * np.abs(k).max())
+    # a stretch constant over the element scales a box's mass by s_x s_y s_z
+    box = hex8.CORNERS[None] * 0.5
+    const = np.broadcast_to(np.array([1 - 2j, 1.0, 3 - 1j]), (1, 8, 3))
+    np.testing.assert_allclose(hex8.lumped_mass(box, np.array([2.0]), const),
+                               hex8.lumped_mass(box, np.array([2.0])) * (1 - 2j) * (3 - 1j))
+    with pytest.raises(FEError, match='stretch must have shape'):
+        hex8.stiffness(coords, young, poisson, np.ones((3, 8)))

@@ -29,6 +29,8 @@ are assembled by :func:`ttb_sim.fe.assembly.assemble_chunked`.
 
 from __future__ import annotations
 
+from typing import Optional
+
 import numpy as np
 
 from ttb_sim.errors import FEError
@@ -88,9 +90,28 @@ def _jacobians(coords: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return grad, det
 
 
+def stretched(grad: np.ndarray, det: np.ndarray, stretch: Optional[np.ndarray]
+              ) -> tuple[np.ndarray, np.ndarray]:
+    """
+    Return the gradients and volume factors in complex-stretched coordinates.
+
+    A perfectly matched layer replaces x_i by x~_i with dx~_i = s_i dx_i
+    (s_i complex, one per axis and Gauss point): d/dx~_i = (1 / s_i) d/dx_i and
+    dV~ = s_x s_y s_z dV. Without a stretch the inputs are returned unchanged.
+    Only the real-to-complex change of type is new; the integrals keep their
+    form (transposes, not conjugates, so the matrices stay complex symmetric).
+    """
+    if stretch is None:
+        return grad, det
+    s = np.asarray(stretch)
+    if s.shape != det.shape + (3,):
+        raise FEError(f'stretch must have shape {det.shape + (3,)}, not {s.shape}')
+    return grad / s[:, :, None, :], det * np.prod(s, axis=-1)
+
+
 def strain_matrices(grad: np.ndarray) -> np.ndarray:
     """Return B (strain = B u_e) from shape-function gradients, shape (..., 6, 24)."""
-    b = np.zeros(grad.shape[:-2] + (6, 24))
+    b = np.zeros(grad.shape[:-2] + (6, 24), dtype=grad.dtype)
     gx, gy, gz = grad[..., 0], grad[..., 1], grad[..., 2]
     b[..., 0, 0::3] = gx
     b[..., 1, 1::3] = gy
@@ -104,7 +125,8 @@ def strain_matrices(grad: np.ndarray) -> np.ndarray:
     return b
 
 
-def stiffness(coords: np.ndarray, young: np.ndarray, poisson: np.ndarray) -> np.ndarray:
+def stiffness(coords: np.ndarray, young: np.ndarray, poisson: np.ndarray,
+              stretch: Optional[np.ndarray] = None) -> np.ndarray:
     """
     Return element stiffness matrices K_e = sum_g w_g det J_g B_g^T D B_g.
 
@@ -114,14 +136,17 @@ def stiffness(coords: np.ndarray, young: np.ndarray, poisson: np.ndarray) -> np.
         Node coordinates (m).
     young, poisson : arrays, shape (m,)
         Young's modulus (Pa) and Poisson's ratio of each element.
+    stretch : complex array, shape (m, 8, 3), optional
+        Complex coordinate stretch (s_x, s_y, s_z) at each Gauss point, for a
+        perfectly matched layer in the frequency domain (:func:`stretched`).
 
     Returns
     -------
     numpy.ndarray
-        Shape (m, 24, 24), N/m.
+        Shape (m, 24, 24), N/m; complex (and complex symmetric) with a stretch.
 
     """
-    grad, det = _jacobians(np.asarray(coords, dtype=float))
+    grad, det = stretched(*_jacobians(np.asarray(coords, dtype=float)), stretch)
     m = len(grad)
     young = np.asarray(young, dtype=float)
     poisson = np.broadcast_to(np.asarray(poisson, dtype=float), young.shape)
@@ -139,10 +164,10 @@ def stiffness(coords: np.ndarray, young: np.ndarray, poisson: np.ndarray) -> np.
     return k.reshape(m, 24, 24)
 
 
-def stiffness_reference(coords: np.ndarray, young: np.ndarray,
-                        poisson: np.ndarray) -> np.ndarray:
+def stiffness_reference(coords: np.ndarray, young: np.ndarray, poisson: np.ndarray,
+                        stretch: Optional[np.ndarray] = None) -> np.ndarray:
     """Return K_e = sum_g w_g det J_g B_g^T D B_g with explicit B matrices (slow; for tests)."""
-    grad, det = _jacobians(np.asarray(coords, dtype=float))
+    grad, det = stretched(*_jacobians(np.asarray(coords, dtype=float)), stretch)
     b = strain_matrices(grad)
     d = elasticity(young, poisson)
     db = np.matmul(d[:, None], b)
@@ -167,8 +192,14 @@ def consistent_mass(coords: np.ndarray, density: np.ndarray) -> np.ndarray:
     return m
 
 
-def lumped_mass(coords: np.ndarray, density: np.ndarray) -> np.ndarray:
-    """Return row-sum lumped nodal masses rho int N_a dV, shape (m, 8), kg."""
-    _, det = _jacobians(np.asarray(coords, dtype=float))
+def lumped_mass(coords: np.ndarray, density: np.ndarray,
+                stretch: Optional[np.ndarray] = None) -> np.ndarray:
+    """
+    Return row-sum lumped nodal masses rho int N_a dV, shape (m, 8), kg.
+
+    With a ``stretch`` (as in :func:`stiffness`) the volume element is the
+    stretched one and the masses are complex.
+    """
+    _, det = stretched(*_jacobians(np.asarray(coords, dtype=float)), stretch)
     return np.einsum('ga,eg->ea', _N, det * GAUSS_WEIGHTS) * \
         np.asarray(density, dtype=float)[:, None]

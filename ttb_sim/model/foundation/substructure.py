@@ -109,6 +109,9 @@ class PileSoilModel:
         Observation points in the soil.
     summary : dict
         DOF and cell counts, element sizes, highest frequency carried.
+    cell_coordinates : array, shape (m, 8, 3)
+        Corner coordinates of each cell (m), those the element matrices were
+        integrated on (``mesh.nodes[mesh.cells]`` but across a periodic seam).
 
     """
 
@@ -132,6 +135,7 @@ class PileSoilModel:
     surface_weights: np.ndarray
     soil_points: SoilPoints
     summary: dict = field(default_factory=dict)
+    cell_coordinates: np.ndarray = field(default_factory=lambda: np.zeros((0, 8, 3)))
 
     @property
     def n_dofs(self) -> int:
@@ -219,7 +223,7 @@ def build(spec: Substructure, load: Optional[PileLoad] = None) -> PileSoilModel:
     mesh = _mesh(split, tags, outer)
     aspect = check_aspect(spec, cut.coordinates, tags.material)
     n_dofs = 3 * mesh.n_nodes
-    mats = _materials(spec)
+    mats = materials(spec)
     cells = mesh.cells
     dofs = node_dofs(cells)
     lumped = hex8.lumped_mass(cut.coordinates, mats.density[tags.material])
@@ -241,7 +245,7 @@ def build(spec: Substructure, load: Optional[PileLoad] = None) -> PileSoilModel:
     _report(summary, load)
     return PileSoilModel(spec, grid, mesh, tags.kind, free, mass, k_soil, c_soil, k_str, c_str,
                          k_b, c_b, iface, law, structure_dofs, head_d, head_r, surface_w,
-                         points, summary)
+                         points, summary, cut.coordinates)
 
 
 def _outer_faces(cut: GridCells, tags: CellTags,
@@ -267,7 +271,7 @@ def _mesh(split: InterfaceSplit, tags: CellTags,
 
 
 @dataclass(frozen=True)
-class _Materials:
+class Materials:
     """Per material (the layers, then pile, then cap): elastic constants and Rayleigh damping."""
 
     young: np.ndarray
@@ -277,7 +281,7 @@ class _Materials:
     beta: np.ndarray
 
 
-def _materials(spec: Substructure) -> _Materials:
+def materials(spec: Substructure) -> Materials:
     """Return the materials of the layers, the piles and the cap."""
     soil, piles, cap = spec.soil, spec.piles, spec.cap
     young = np.array([lay.E for lay in soil.layers] + [piles.E if piles else 1.0, cap.E])
@@ -286,11 +290,11 @@ def _materials(spec: Substructure) -> _Materials:
     zeta = np.array([lay.damping_ratio for lay in soil.layers]
                     + [piles.damping_ratio if piles else 0.0, cap.damping_ratio])
     alpha, beta = rayleigh_coefficients(zeta, spec.rayleigh_frequencies)
-    return _Materials(young, poisson, density, alpha, beta)
+    return Materials(young, poisson, density, alpha, beta)
 
 
 def _linear_operators(sel: np.ndarray, dofs: np.ndarray, coords: np.ndarray,
-                      material: np.ndarray, mats: _Materials, lumped: np.ndarray,
+                      material: np.ndarray, mats: Materials, lumped: np.ndarray,
                       n_dofs: int) -> tuple[sp.csr_matrix, sp.csr_matrix]:
     """
     Return the stiffness K and Rayleigh damping alpha M + beta K of the cells ``sel``.
@@ -318,7 +322,7 @@ def _linear_operators(sel: np.ndarray, dofs: np.ndarray, coords: np.ndarray,
 
 
 def _boundary(spec: Substructure, mesh: Mesh, outer: list[tuple[str, int, np.ndarray]],
-              coords: np.ndarray, mats: _Materials, n_dofs: int
+              coords: np.ndarray, mats: Materials, n_dofs: int
               ) -> tuple[np.ndarray, sp.csr_matrix, sp.csr_matrix]:
     """
     Return the free DOFs and the boundary's springs and dashpots (K, C).

@@ -18,7 +18,8 @@ Closed forms for the pile-soil validation cases V11-V16 (PHYSICS.md 9.4-9.5).
 Independent of the finite-element code: the Randolph-Wroth head stiffness of
 a single pile, Gazetas' fit for the same, the modes of a layered shear column
 on a rigid base (exact, from the layer transfer matrices, and the
-quarter-wavelength estimate with the travel-time average Vs), and the
+quarter-wavelength estimate with the travel-time average Vs), the surface
+receptance of a layered column on a half-space under a harmonic load, and the
 Clough-Duncan hyperbola with its Mohr-Coulomb cap.
 """
 
@@ -124,6 +125,36 @@ def shear_column_frequencies(thicknesses: Sequence[float], shear_moduli: Sequenc
         if len(roots) == n:
             break
     return np.array(roots)
+
+
+def layered_column_receptance(thicknesses: Sequence[float], moduli: Sequence[float],
+                              densities: Sequence[float], alphas: Sequence[float],
+                              betas: Sequence[float], frequency: float) -> complex:
+    """
+    Return the surface displacement per unit surface traction of layers on a half-space (m/Pa).
+
+    One-dimensional waves (a uniform load on the whole surface of laterally
+    unbounded layers): constrained modulus E(1-nu)/((1+nu)(1-2nu)) for a normal
+    load, G for a shear load. The last entry of every list is the half-space
+    (its thickness is ignored). Rayleigh damping C = alpha M + beta K per
+    layer: the modulus becomes M (1 + i w beta) and the density
+    rho (1 - i alpha / w). Each layer's transfer matrix carries the surface
+    impedance I = tau / u (tau = M du/dz, z down) of what lies below it up to
+    its top, from I = -i k M of the outgoing wave in the half-space
+    (Im k < 0: decaying with depth); the receptance is -1 / I at the surface.
+    """
+    w = 2.0 * math.pi * frequency
+    if not w > 0:
+        raise ValueError('the receptance of a column on a half-space needs f > 0')
+    m = np.asarray(moduli, dtype=float) * (1.0 + 1j * w * np.asarray(betas, dtype=float))
+    rho = np.asarray(densities, dtype=float) * (1.0 - 1j * np.asarray(alphas, dtype=float) / w)
+    k = w * np.sqrt(rho / m)
+    k = np.where(k.imag > 0, -k, k)
+    impedance = -1j * k[-1] * m[-1]
+    for h, kj, mj in zip(reversed(list(thicknesses[:-1])), reversed(k[:-1]), reversed(m[:-1])):
+        c, s = np.cos(kj * h), np.sin(kj * h)
+        impedance = (impedance * c + mj * kj * s) / (c - impedance * s / (mj * kj))
+    return complex(-1.0 / impedance)
 
 
 def hyperbola_stress(strain: np.ndarray, k0: float, strength: float,
