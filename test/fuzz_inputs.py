@@ -212,7 +212,8 @@ def refused_pairs(draw: Any, but: tuple[str, ...] = ()) -> tuple[str, str]:
 
 # -- command lines -------------------------------------------------------------------------
 
-VERBS = ['run', 'validate', 'bench', 'modes', 'analyze', 'compare', 'sweep', 'scenarios']
+VERBS = ['run', 'validate', 'bench', 'modes', 'frf', 'analyze', 'compare', 'sweep',
+         'scenarios']
 """The verbs of ``ttb-sim``."""
 
 PATHS = ['missing', 'missing.yaml', 'file.txt', 'empty.yaml', 'twice.yaml', 'dir', 'bag',
@@ -234,10 +235,14 @@ GOOD = {'--duration': ['0.002'], '--speed-kmh': ['250'], '--speeds-kmh': ['250,3
         '--seeds': ['2'], '--workers': ['1'], '--storage': ['mcap', 'sqlite3'],
         '--set': ['train.speed_kmh=250', 'solver.dt=2e-4'], '--around': ['5'], '--count': ['3'],
         '--variants': ['reference'], '--repeat': ['1'], '--labels': ['a,b'],
-        '--out': ['out/new'], '--json': ['out.json'], '--scheduler': ['tcp://127.0.0.1:9']}
+        '--out': ['out/new'], '--json': ['out.json'], '--scheduler': ['tcp://127.0.0.1:9'],
+        '--freqs': ['2', '1:3:1'], '--pml': ['3'], '--solver': ['superlu'],
+        '--plot': ['out.png']}
 """A value each option accepts, so that some vectors pass the checks."""
 
+# frf's good positional is refused (not a substructure run): a fuzzed frf must stay quick
 POSITIONALS = {'run': ['moving_force_beam', 'sprung_mass_beam'], 'modes': ['moving_force_beam'],
+               'frf': ['moving_force_beam'],
                'sweep': ['moving_force_beam'], 'bench': ['moving_force_beam'],
                'analyze': ['bag'], 'compare': ['bag', 'bag'], 'validate': ['V1']}
 """What each verb accepts as its positional argument(s)."""

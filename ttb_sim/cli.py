@@ -72,7 +72,7 @@ def _parser() -> argparse.ArgumentParser:
 
 
 def _add_model_verbs(sub: Any) -> None:
-    """Add the verbs that build a scenario's model: run, validate, bench, modes."""
+    """Add the verbs that build a scenario's model: run, validate, bench, modes, frf."""
     run = sub.add_parser('run', help='simulate a scenario and record a rosbag2')
     run.add_argument('scenario', nargs='?', default=DEFAULT_SCENARIO,
                      help='YAML path or built-in name (see `ttb-sim scenarios`; default '
@@ -123,6 +123,23 @@ def _add_model_verbs(sub: Any) -> None:
     mo.add_argument('--set', dest='overrides', action='append', default=[],
                     metavar='KEY=VALUE', help='override a scenario key; repeatable')
     mo.add_argument('--json', type=Path, metavar='FILE', help='also write the modes as JSON')
+
+    fr = sub.add_parser('frf', help='frequency response of a pile-soil substructure scenario '
+                        '(steady harmonic receptances), and whether its mesh holds')
+    fr.add_argument('scenario', help='YAML path or built-in name with load.type not none '
+                    '(e.g. single_pile)')
+    fr.add_argument('--freqs', default='1:10:1', help="Hz: comma-separated ('1,2,5') or "
+                    "START:STOP:STEP (default 1:10:1)")
+    fr.add_argument('--refine', action='store_true', help='also solve with every element size '
+                    'halved and report the change')
+    fr.add_argument('--pml', type=float, metavar='M', help='a perfectly matched layer of this '
+                    "thickness around the block instead of the scenario's boundary")
+    fr.add_argument('--solver', default='auto', help='complex sparse solver: auto (pardiso '
+                    'if installed), pardiso, superlu')
+    fr.add_argument('--set', dest='overrides', action='append', default=[],
+                    metavar='KEY=VALUE', help='override a scenario key; repeatable')
+    fr.add_argument('--json', type=Path, metavar='FILE', help='also write the receptances')
+    fr.add_argument('--plot', type=Path, metavar='FILE', help='also draw them (PNG)')
 
 
 def _add_bag_verbs(sub: Any) -> None:
@@ -279,6 +296,11 @@ def _main(argv: Sequence[str] | None) -> int:
                                  duration=args.duration, json_path=args.json,
                                  repeat=args.repeat, isolate=not args.in_process,
                                  overrides=args.overrides, threads=args.threads)
+        if args.command == 'frf':
+            from ttb_sim.commands.frf import frf_command
+            return frf_command(args.scenario, args.freqs, pml=args.pml, refine=args.refine,
+                               solver=args.solver, overrides=args.overrides,
+                               json_path=args.json, plot_path=args.plot)
         if args.command == 'modes':
             from ttb_sim.commands.modes import modes_command
             return modes_command(args.scenario, around=args.around, count=args.count,
