@@ -203,11 +203,19 @@ class SubstructureRun:
         return 1 + self.n_steps // self.output_every
 
     def describe(self) -> dict[str, Any]:
-        """Return the model's sizes and the stepping plan (for ``summary.json``)."""
+        """
+        Return the model's sizes and the stepping plan (for ``summary.json``).
+
+        ``interface_solve`` holds the counts of the interface iterations so far
+        (:meth:`PartitionedNewmark.report`: linear solves, (sub-)steps solved by
+        the full Newton line search, steps cut into sub-steps and the halvings
+        made), or None for a static load.
+        """
         return {'pile_soil': dict(self.model.summary), 'scheme': self.scheme,
                 'variant': self.variant.name, 'factorization': self.factorization,
                 'stable_step': None if math.isinf(self.stable_step) else self.stable_step,
-                'load': self.load.type}
+                'load': self.load.type,
+                'interface_solve': None if self.integrator is None else self.integrator.report()}
 
     def plan(self, messages_per_frame: int) -> CostEstimate:
         """Return the cost estimate of the run (before it runs)."""
@@ -246,10 +254,19 @@ class SubstructureRun:
             state = initial_state(self.model)
             yield self._frame(0, state)
             history = self.load.history
+            previous = history(0.0)
             for step in range(1, self.n_steps + 1):
-                state = self.integrator.step(state, self.force, history(step * self.dt))
+                factor = history(step * self.dt)
+                state = self.integrator.step(state, self.force, factor, start_factor=previous)
+                previous = factor
                 if step % self.output_every == 0:
                     yield self._frame(step, state)
+            counts = self.integrator.report()
+            if counts['cut_steps'] or counts['line_searches']:
+                log.warning('pile-soil: %d of %d steps cut into sub-steps (%d halvings), %d '
+                            '(sub-)steps solved by the full Newton line search',
+                            counts['cut_steps'], self.n_steps, counts['cuts'],
+                            counts['line_searches'])
 
     def _frame(self, step: int, state: State) -> Frame:
         limit = self.scenario.solver.divergence_limit
