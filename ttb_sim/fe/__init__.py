@@ -21,7 +21,8 @@ hexahedron), ``quad`` and ``interface`` (4-node faces, Desai thin-layer elements
 named sets; structured grids and their cuts), ``assembly`` (the one COO-once sparse
 assembler, chunked for large meshes, and spring-dashpot links), ``dofs`` (:class:`DofMap`:
 full/free numbering, substructure blocks and interfaces), ``factorization`` (symmetric
-sparse direct solvers behind one function), ``bisection`` (a long matrix solved as two
+sparse direct solvers behind one function), ``complex_solve`` (complex symmetric sparse
+solves), ``symmetry`` (mirror-symmetry reduction of a mesh), ``bisection`` (a long matrix solved as two
 halves on two cores), ``compiled`` (numba compilation of the package's kernels).
 """
 

@@ -20,5 +20,7 @@ The piers' foundations: springs or piled, and the 3-D pile-soil substructure of 
 cross-checks), :mod:`.desai` (the interface law), :mod:`.soil_mesh`, :mod:`.substructure`
 and :mod:`.observation` (the finite-element substructure), :mod:`.operator` (what the
 bridge sees of it), :mod:`.tied`, :mod:`.krylov`, :mod:`.reduction` and
-:mod:`.operator_cache` (its reduced operator and the cache of it).
+:mod:`.operator_cache` (its reduced operator and the cache of it), :mod:`.frequency_response`
+(its harmonic response in the frequency domain, with a perfectly matched layer: the reference
+of mesh convergence).
 """
