@@ -129,7 +129,7 @@ def _add_model_verbs(sub: Any) -> None:
     fr.add_argument('scenario', help='YAML path or built-in name with load.type not none '
                     '(e.g. single_pile)')
     fr.add_argument('--freqs', default='1:10:1', help="Hz: comma-separated ('1,2,5') or "
-                    "START:STOP:STEP (default 1:10:1)")
+                    'START:STOP:STEP (default 1:10:1)')
     fr.add_argument('--refine', action='store_true', help='also solve with every element size '
                     'halved and report the change')
     fr.add_argument('--pml', type=float, metavar='M', help='a perfectly matched layer of this '

@@ -22,8 +22,8 @@ named sets; structured grids and their cuts), ``assembly`` (the one COO-once spa
 assembler, chunked for large meshes, and spring-dashpot links), ``dofs`` (:class:`DofMap`:
 full/free numbering, substructure blocks and interfaces), ``factorization`` (symmetric
 sparse direct solvers behind one function), ``complex_solve`` (complex symmetric sparse
-solves), ``symmetry`` (mirror-symmetry reduction of a mesh), ``bisection`` (a long matrix solved as two
-halves on two cores), ``compiled`` (numba compilation of the package's kernels).
+solves), ``symmetry`` (mirror-symmetry reduction of a mesh), ``bisection`` (a long matrix
+solved as two halves on two cores), ``compiled`` (numba compilation of the package's kernels).
 """
 
 from ttb_sim.fe.assembly import assemble, assemble_links, link_kinematics
