@@ -35,7 +35,7 @@ from ttb_sim.model.foundation.records import (BlockSize, Interface, MeshSize, Ob
                                               Substructure)
 from ttb_sim.model.foundation.substructure import build
 from ttb_sim.sim.substructure import PartitionedNewmark, SubstructureRun
-from ttb_sim.sim.substructure.stepping import initial_state
+from ttb_sim.sim.substructure.state import initial_state
 
 SHALLOW_LAYERS = [
     {'thickness': 2.0, 'E': 4.0e6, 'nu': 0.35, 'rho': 1834.862, 'c': 20.0e3, 'phi': 5.0},

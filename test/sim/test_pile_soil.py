@@ -27,7 +27,8 @@ from ttb_sim.model.foundation.records import (BlockSize, Interface, MeshSize, Ob
                                               Substructure)
 from ttb_sim.model.foundation.substructure import build
 from ttb_sim.sim.substructure import observe, PartitionedNewmark, states, SubstructureRun
-from ttb_sim.sim.substructure.stepping import initial_state, stable_time_step
+from ttb_sim.sim.substructure.stable_step import stable_time_step
+from ttb_sim.sim.substructure.state import initial_state
 from ttb_sim.validation.cases.pile_soil import (boundary_reflection, harmonic_convergence,
                                                 head_stiffness, randolph_wroth_reference,
                                                 single_pile)

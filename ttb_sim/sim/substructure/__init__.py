@@ -16,16 +16,21 @@
 Pier-cap-pile-soil substructures stepped beside the bridge, or on their own.
 
 ``stepping`` advances one pile-soil block ([P] Eqs. 12-14: the partitioned
-Newmark scheme, the static solve, observations), ``piled_piers`` couples the
-reduced substructures of piled piers to the bridge through the bearings, and
-``standalone`` runs one substructure alone (``scenario.substructure_only``).
+Newmark scheme) over ``stable_step`` (the implicit-explicit partition and the
+explicit stable step) and ``state`` (the state, its observation, the interface
+response); ``statics`` solves the block under a static load. ``piled_piers``
+couples the reduced substructures of piled piers to the bridge through the
+bearings, and ``standalone`` runs one substructure alone
+(``scenario.substructure_only``).
 """
 
 from ttb_sim.sim.substructure.piled_piers import PiledFoundations
+from ttb_sim.sim.substructure.stable_step import implicit_dofs
 from ttb_sim.sim.substructure.standalone import (reference_refusal, substructure_dof_counts,
                                                  SubstructureRun)
-from ttb_sim.sim.substructure.stepping import (implicit_dofs, observe, PartitionedNewmark, State,
-                                               states, static_solve)
+from ttb_sim.sim.substructure.state import observe, State
+from ttb_sim.sim.substructure.statics import static_solve
+from ttb_sim.sim.substructure.stepping import PartitionedNewmark, states
 
 __all__ = ['implicit_dofs', 'observe', 'PartitionedNewmark', 'PiledFoundations',
            'reference_refusal', 'State', 'states', 'static_solve', 'substructure_dof_counts',

@@ -55,8 +55,10 @@ from ttb_sim.model.foundation.soil_mesh import CAP, PILE, planned_nodes, SOIL
 from ttb_sim.model.foundation.substructure import build, PileSoilModel
 from ttb_sim.sim.cost import CostEstimate, STEP_BUDGET
 from ttb_sim.sim.frames import Frame, Layout
-from ttb_sim.sim.substructure.stepping import (implicit_dofs, initial_state, mixed_stable_step,
-                                               observe, PartitionedNewmark, State, static_solve)
+from ttb_sim.sim.substructure.stable_step import implicit_dofs, mixed_stable_step
+from ttb_sim.sim.substructure.state import initial_state, observe, State
+from ttb_sim.sim.substructure.statics import static_solve
+from ttb_sim.sim.substructure.stepping import PartitionedNewmark
 from ttb_sim.sim.variants import blas_threads, solver_variant, VARIANTS
 
 __all__ = ['SubstructureRun', 'AUTO_STEPS_PER_PERIOD', 'AUTO_PERIODS', 'reference_refusal',

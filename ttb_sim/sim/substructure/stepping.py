@@ -13,7 +13,7 @@
 # limitations under the License.
 
 """
-Time stepping and static solution of the pile-soil substructure on its own.
+Time stepping of the pile-soil substructure on its own.
 
 Integrator: Newmark's average acceleration (beta = 1/4, gamma = 1/2) in the
 implicit-explicit predictor-corrector form of Hughes & Liu (J. Appl. Mech. 45,
@@ -30,7 +30,7 @@ small system whose matrix M_I + dt/2 C_I + dt^2/4 (K_I + K_ifc,0) is
 factorised once. With every group implicit this is the ordinary Newmark
 method (unconditionally stable); explicit groups are stable for
 omega_max dt <= 2 (reduced by their stiffness-proportional damping, see
-:func:`stable_time_step`).
+:func:`~ttb_sim.sim.substructure.stable_step.stable_time_step`).
 
 ``scheme='mixed'`` makes the soil cells and the boundary explicit and the
 piles, cap and interface implicit. The reason is the contrast of wave speeds:
@@ -49,7 +49,7 @@ iterations, as under heavy slip, the current tangent is factorised afresh
 every 15 iterations) or with the current tangent
 refactorised at each iteration (``newton='full'``, for checking). The Desai
 plastic slip is committed when the step has converged. Output is one
-:class:`PileSoilFrame` per output interval.
+:class:`~ttb_sim.sim.substructure.state.PileSoilFrame` per output interval.
 
 A step whose iterations do not converge is retried, and only such a step: the
 steps that converge take the path above unchanged. First full Newton (current
@@ -70,152 +70,22 @@ warnings and counted (:meth:`PartitionedNewmark.report`).
 
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
-import inspect
+from dataclasses import dataclass
 import logging
 import math
 from typing import Callable, Iterator, Literal, Optional
 
 import numpy as np
 import scipy.sparse as sp
-import scipy.sparse.linalg as sla
 
 from ttb_sim.errors import DivergenceError, SimulationError
-from ttb_sim.fe import hex8
 from ttb_sim.fe.factorization import Factorization, factorize
 from ttb_sim.model.foundation.substructure import PileSoilModel, rayleigh_coefficients
+from ttb_sim.sim.substructure.stable_step import (choose_scheme, implicit_dofs, mixed_stable_step,
+                                                  Scheme)
+from ttb_sim.sim.substructure.state import initial_state, interface_response, State
 
 LOG = logging.getLogger(__name__)
-
-Scheme = Literal['auto', 'mixed', 'implicit']
-
-
-@dataclass(frozen=True)
-class PileSoilFrame:
-    """
-    Observed response at one instant (SI units, global axes, z up).
-
-    Attributes
-    ----------
-    time : float
-        s.
-    pile_displacement, pile_acceleration : arrays, shape (n_piles, 3)
-        Pile-head area-weighted mean displacement (m) and acceleration (m/s^2).
-    pile_rotation, pile_rotation_rate : arrays, shape (n_piles, 3)
-        Pile-head rigid rotation (rad) and rotation rate (rad/s).
-    soil_displacement, soil_acceleration, soil_velocity : arrays, shape (n_points, 3)
-        At the model's soil points (m, m/s^2, m/s).
-
-    """
-
-    time: float
-    pile_displacement: np.ndarray
-    pile_acceleration: np.ndarray
-    pile_rotation: np.ndarray
-    pile_rotation_rate: np.ndarray
-    soil_displacement: np.ndarray
-    soil_acceleration: np.ndarray
-    soil_velocity: np.ndarray
-
-
-@dataclass(frozen=True)
-class State:
-    """Full state: time (s), u (m), v (m/s), a (m/s^2), interface slip (k, 4, 2)."""
-
-    time: float
-    u: np.ndarray
-    v: np.ndarray
-    a: np.ndarray
-    slip: Optional[np.ndarray]
-
-
-def observe(model: PileSoilModel, state: State) -> PileSoilFrame:
-    """Return the observed frame of a state."""
-    n_p = model.n_piles
-    hd, hr, sp_op = model.head_displacement, model.head_rotation, model.soil_points.operator
-    n_s = len(model.soil_points.names)
-    return PileSoilFrame(state.time, (hd @ state.u).reshape(n_p, 3),
-                         (hd @ state.a).reshape(n_p, 3), (hr @ state.u).reshape(n_p, 3),
-                         (hr @ state.v).reshape(n_p, 3), (sp_op @ state.u).reshape(n_s, 3),
-                         (sp_op @ state.a).reshape(n_s, 3), (sp_op @ state.v).reshape(n_s, 3))
-
-
-def _interface_response(model: PileSoilModel, u: np.ndarray, slip: Optional[np.ndarray]
-                        ) -> tuple[np.ndarray, Optional[np.ndarray], Optional[np.ndarray]]:
-    """Return (internal force, tangent (k,4,3), trial slip) of the interface at u."""
-    if model.interface is None or model.law is None or slip is None:
-        return np.zeros_like(u), None, None
-    stress, tangent, new_slip = model.law.evaluate(model.interface.strain(u), slip)
-    return model.interface.force(stress), tangent, new_slip
-
-
-def explicit_omega_max(model: PileSoilModel) -> float:
-    """
-    Return an upper bound of the largest circular frequency (rad/s) of the soil cells.
-
-    The largest eigenvalue of the assembled lumped-mass system is bounded by the
-    largest over elements of each element's own K_e / m_e problem (element
-    eigenvalue inequality; the assembled nodal masses are at least the
-    element's). The structured soil cells are bricks, so the bound is taken
-    over the distinct (dx, dy, dz, layer) combinations; boundary springs are
-    added per node. Periodic columns (merged nodes) fall back on Lanczos.
-    """
-    mesh = model.mesh
-    soil = mesh.cell_sets['soil']
-    x = mesh.nodes[mesh.cells[soil]]
-    span = x.max(axis=1) - x.min(axis=1)
-    if model.spec.soil.periodic or np.any(span <= 0):
-        free = np.flatnonzero(model.free)
-        k = (model.soil_stiffness + model.boundary_stiffness).tocsr()[free][:, free]
-        scale = 1.0 / np.sqrt(model.mass[free])
-        op = sla.LinearOperator(k.shape, matvec=lambda v: scale * (k @ (scale * v)),
-                                dtype=float)
-        value = sla.eigsh(op, k=1, which='LA', tol=1e-4, return_eigenvectors=False,
-                          ncv=min(40, len(free) - 1))[0]
-        return float(math.sqrt(value) * 1.001)
-    key = np.column_stack([np.round(span, 6), mesh.material[soil]])
-    unique = np.unique(key, axis=0)
-    layers = model.spec.soil.layers
-    young = np.array([layers[int(m)].E for m in unique[:, 3]])
-    poisson = np.array([layers[int(m)].nu for m in unique[:, 3]])
-    rho = np.array([layers[int(m)].rho for m in unique[:, 3]])
-    coords = (hex8.CORNERS[None] + 1.0) / 2.0 * unique[:, None, :3]
-    k_e = hex8.stiffness(coords, young, poisson)
-    m_e = np.repeat(hex8.lumped_mass(coords, rho), 3, axis=1)
-    scaled = k_e / np.sqrt(m_e[:, :, None] * m_e[:, None, :])
-    omega2 = float(np.linalg.eigvalsh(scaled)[:, -1].max())
-    boundary = model.boundary_stiffness.diagonal() / model.mass
-    return float(math.sqrt(omega2 + float(boundary.max(initial=0.0))) * 1.01)
-
-
-def stable_time_step(omega: float, alpha: float, beta: float, safety: float = 0.9) -> float:
-    """
-    Return the largest stable step (s) of the explicit predictor-corrector at omega.
-
-    The undamped limit is omega dt = 2; Rayleigh damping c = alpha + beta omega^2
-    evaluated with the predicted velocity lowers it. Found by bisection on the
-    spectral radius of the one-DOF amplification matrix, times ``safety``.
-    """
-    c = alpha + beta * omega**2
-
-    def radius(dt: float) -> float:
-        amp = np.zeros((3, 3))
-        for j in range(3):
-            u, v, a = np.eye(3)[j]
-            ut = u + dt * v + dt * dt / 4 * a
-            vt = v + dt / 2 * a
-            an = -omega**2 * ut - c * vt
-            amp[:, j] = [ut + dt * dt / 4 * an, vt + dt / 2 * an, an]
-        return float(max(abs(np.linalg.eigvals(amp))))
-
-    lo, hi = 0.0, 2.0 / omega
-    for _ in range(60):
-        mid = 0.5 * (lo + hi)
-        if radius(mid) <= 1.0 + 1e-12:
-            lo = mid
-        else:
-            hi = mid
-    return safety * lo
 
 
 @dataclass(frozen=True)
@@ -432,7 +302,7 @@ class PartitionedNewmark:
         if slip is None:
             return residual, None, None
         u_full[self.implicit] = u_i
-        f_ifc, tangent, new_slip = _interface_response(self.model, u_full, slip)
+        f_ifc, tangent, new_slip = interface_response(self.model, u_full, slip)
         residual -= f_ifc[self.implicit]
         return residual, tangent, new_slip
 
@@ -529,122 +399,6 @@ class PartitionedNewmark:
         LOG.info('t = %.6g s: full Newton did not converge in %d iterations (|r| = %.3g times '
                  'the tolerance)', p.time, self.line_search_iterations, norm / limit)
         return None
-
-
-_CG_TOLERANCE = 'rtol' if 'rtol' in inspect.signature(sla.cg).parameters else 'tol'
-"""The relative-tolerance argument of scipy's cg: 'rtol' from scipy 1.12, 'tol' before (the
-Debian bookworm scipy 1.10 that a ROS 2 Jazzy build uses)."""
-
-
-def initial_state(model: PileSoilModel) -> State:
-    """Return the geostatic state at rest (zero displacement from it, no slip)."""
-    n = model.n_dofs
-    slip = None if model.interface is None else np.zeros((model.interface.n_elements, 4, 2))
-    return State(0.0, np.zeros(n), np.zeros(n), np.zeros(n), slip)
-
-
-def implicit_dofs(model: PileSoilModel) -> np.ndarray:
-    """Return a mask of the DOFs of pile and cap cells and of interface elements."""
-    mask = model.structure_dofs.copy()
-    if model.interface is not None:
-        mask[np.unique(model.interface.relative.indices)] = True
-    return mask
-
-
-def static_solve(model: PileSoilModel, force: np.ndarray, increments: int = 5,
-                 tolerance: float = 1e-6, max_iterations: int = 50,
-                 cg_tolerance: float = 1e-10, direct: bool = False,
-                 factorization: str = 'cholmod') -> State:
-    """
-    Return the static state under ``force`` (N), applied in equal increments.
-
-    [P] section 2.4: each increment is iterated to equilibrium and the slip
-    committed. Each Newton iteration (current interface tangent) is solved by
-    preconditioned conjugate gradients: the preconditioner inverts the pile,
-    cap and interface block exactly (factorised once, by ``factorization`` as
-    in :class:`PartitionedNewmark`) and the soil diagonal, so the stiffness
-    contrast between piles and soil costs nothing and the whole 3-D soil is
-    never factorised. ``direct=True`` instead solves each iteration with a
-    direct factorisation of the whole initial tangent (modified Newton, the
-    current tangent refactorised when an increment needs more than 15
-    iterations, as :class:`PartitionedNewmark`): the reference path, for
-    models small enough.
-
-    Raises
-    ------
-    SimulationError
-        If the boundary leaves rigid-body motion (dashpots only) or the
-        iterations do not converge.
-
-    """
-    if model.spec.soil.boundary == 'lysmer':
-        raise SimulationError("a static load needs soil.boundary 'viscoelastic' or 'fixed'; "
-                              "'lysmer' (dashpots only) leaves the block floating")
-    free = np.flatnonzero(model.free)
-    k_lin = model.linear_stiffness()
-    k_lin_free = k_lin[free][:, free]
-    k0 = (k_lin + model.initial_interface_stiffness()).tocsr()[free][:, free]
-    block = np.flatnonzero(implicit_dofs(model)[free])
-    diagonal = k0.diagonal()
-    block_factor = (factorize(k0[block][:, block], method=factorization)
-                    if len(block) and not direct else None)
-
-    def precondition(r: np.ndarray) -> np.ndarray:
-        x = r / diagonal
-        if block_factor is not None:
-            x[block] = block_factor.solve(r[block])
-        return x
-
-    preconditioner = sla.LinearOperator(k0.shape, matvec=precondition, dtype=float)
-    state = initial_state(model)
-    u = state.u.copy()
-    slip = state.slip
-    scale = max(float(np.linalg.norm(force)), 1e-30)
-    # direct: modified Newton on the initial tangent, refactorised at the current tangent
-    # when an increment needs more than 15 iterations (as PartitionedNewmark)
-    direct_factor = factorize(k0, method=factorization) if direct else None
-    for step in range(1, increments + 1):
-        target = force * step / increments
-        for it in range(max_iterations):
-            f_ifc, tangent, _ = _interface_response(model, u, slip)
-            residual = target[free] - k_lin_free @ u[free] - f_ifc[free]
-            if np.linalg.norm(residual) <= tolerance * scale:
-                break
-            k_t = k_lin_free
-            if tangent is not None:
-                assert model.interface is not None
-                k_t = k_lin_free + model.interface.stiffness(tangent)[free][:, free]
-            if direct_factor is not None:
-                if it > 0 and it % 15 == 0:
-                    direct_factor = factorize(k_t, method=factorization)
-                du = direct_factor.solve(residual)
-            else:
-                du, info = sla.cg(k_t, residual, M=preconditioner, maxiter=20 * len(free),
-                                  **{_CG_TOLERANCE: cg_tolerance})
-                if info != 0:
-                    raise SimulationError(f'static solve: conjugate gradients stopped ({info})')
-            u[free] += du
-            if model.interface is None:
-                break
-        else:
-            raise SimulationError(f'static iterations did not converge in increment {step}')
-        if model.interface is not None:
-            slip = _interface_response(model, u, slip)[2]
-    return replace(state, u=u, slip=slip)
-
-
-def choose_scheme(model: PileSoilModel, scheme: Scheme) -> Literal['mixed', 'implicit']:
-    """Resolve 'auto': mixed above 20 000 free DOFs (with piles or soil), else implicit."""
-    if scheme == 'auto':
-        return 'mixed' if int(model.free.sum()) > 20000 else 'implicit'
-    return scheme
-
-
-def mixed_stable_step(model: PileSoilModel) -> float:
-    """Return the stable step (s) of the explicit soil in the mixed scheme."""
-    zeta = np.array([layer.damping_ratio for layer in model.spec.soil.layers])
-    alpha, beta = rayleigh_coefficients(zeta, model.spec.rayleigh_frequencies)
-    return stable_time_step(explicit_omega_max(model), float(alpha.min()), float(beta.max()))
 
 
 def states(model: PileSoilModel, force: np.ndarray, history: Callable[[float], float],

@@ -18,9 +18,9 @@ Pile-soil validation cases V11-V16 (VALIDATION.md) and the mesh convergence chec
 Each case builds its substructure from the records users give
 (:mod:`ttb_sim.model.foundation.records` -> :func:`~ttb_sim.model.foundation.substructure.build`)
 and takes the computed number from the model's operators or from the same
-stepping code users run (:mod:`ttb_sim.sim.substructure.stepping`); the references come
-from :mod:`ttb_sim.validation.references.pile_soil`, which shares no code with
-them.
+stepping and static code users run (:mod:`ttb_sim.sim.substructure.stepping`,
+:mod:`ttb_sim.sim.substructure.statics`); the references come from
+:mod:`ttb_sim.validation.references.pile_soil`, which shares no code with them.
 
 V11  Homogeneous column (H = 20 m, E = 5 MPa, nu = 0.25, rho = 1937 kg/m^3,
      Vs = 32.13 m/s) on a rigid base: a laterally periodic column of 40
