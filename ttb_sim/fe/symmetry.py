@@ -129,9 +129,14 @@ def mirror_reduction(nodes: np.ndarray, cells: np.ndarray, material: np.ndarray,
     return sp.csr_matrix((sign.ravel()[rows], (rows, cols)), shape=(3 * n, int(kept.sum())))
 
 
-def load_parity(t: sp.csr_matrix, load: np.ndarray, tolerance: float = 1e-9) -> bool:
-    """Return whether ``load`` lies in the range of T (so the reduction is exact for it)."""
-    counts = np.asarray(abs(t).sum(axis=0)).ravel()
-    projected = t @ ((t.T @ load) / counts)
-    size = float(np.linalg.norm(load))
-    return bool(float(np.linalg.norm(projected - load)) <= tolerance * max(size, 1e-300))
+def has_parity(field: np.ndarray, image: np.ndarray, plane: MirrorPlane,
+               tolerance: float = 1e-9) -> bool:
+    """
+    Return whether the nodal ``field`` (3 per node) has ``plane``'s parity.
+
+    ``image`` is the mirror of every node about the plane (:func:`mirror_nodes`):
+    the field at a node's image must be the field there times the plane's signs.
+    """
+    u = np.asarray(field, dtype=float).reshape(-1, 3)
+    gap = float(np.linalg.norm(u[image] - u * plane.signs()))
+    return gap <= tolerance * max(float(np.linalg.norm(u)), 1e-300)

@@ -56,11 +56,12 @@ from typing import Callable, Literal, Optional, Sequence
 import numpy as np
 import scipy.sparse as sp
 
+from ttb_sim.errors import FEError
 from ttb_sim.fe import hex8
 from ttb_sim.fe.assembly import assemble_chunked
 from ttb_sim.fe.complex_solve import factorize_complex, resolve_method
 from ttb_sim.fe.mesh import node_dofs
-from ttb_sim.fe.symmetry import load_parity, mirror_reduction, MirrorPlane
+from ttb_sim.fe.symmetry import has_parity, mirror_nodes, mirror_reduction, MirrorPlane
 from ttb_sim.model.foundation.records import (BlockSize, FoundationError, PileLoad,
                                               SoilParameters, Substructure)
 from ttb_sim.model.foundation.substructure import build, materials, PileSoilModel
@@ -217,8 +218,21 @@ class DynamicStiffness:
         self.mass = model.mass
         self._cells = np.zeros(0, dtype=int)
         if layer is not None and inner is not None:
-            xyz = model.cell_coordinates
-            self._cells = np.flatnonzero(layer_depth(xyz, inner, layer).max(axis=(1, 2)) > 0)
+            coords = model.cell_coordinates
+            self._cells = np.flatnonzero(layer_depth(coords, inner, layer).max(axis=(1, 2)) > 0)
+            sel = self._cells
+            mats = materials(model.spec)
+            mat = model.mesh.material[sel]
+            self._coords = coords[sel]
+            self._dofs = node_dofs(model.mesh.cells)[sel]
+            self._elastic = (mats.young[mat], mats.poisson[mat], mats.density[mat])
+            self._rayleigh = (mats.alpha[mat], mats.beta[mat])
+            self._gauss = np.einsum('ga,eai->egi', hex8.shape_functions(hex8.GAUSS_POINTS),
+                                    self._coords)
+            # the same cells unstretched, once: Z_plain(w) = (1 + i w beta) K + (i w alpha - w^2) M
+            self._plain = [self._assemble(None, *weights) for weights in
+                           ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0),
+                            (0.0, 0.0, 0.0, 1.0))]
 
     @property
     def layer_cells(self) -> int:
@@ -231,38 +245,34 @@ class DynamicStiffness:
         z = (self.stiffness + (1j * w) * self.damping
              - sp.diags(w * w * self.mass)).tocsr()
         if len(self._cells):
-            z = z + self._layer_correction(w)
+            assert self.layer is not None and self.inner is not None
+            stretched = self._assemble(stretch(self._gauss, self.inner, self.layer, w),
+                                       1.0, 1j * w, 1j * w, -w * w)
+            k, k_beta, m_alpha, m = self._plain
+            z = z + stretched - (k + (1j * w) * k_beta + (1j * w) * m_alpha - (w * w) * m)
         return z.tocsr()
 
-    def _layer_correction(self, w: float) -> sp.csr_matrix:
-        """Return Z of the layer's cells stretched minus the same cells unstretched."""
-        assert self.layer is not None and self.inner is not None
-        model, layer, inner = self.model, self.layer, self.inner
-        mats = materials(model.spec)
-        cells = model.mesh.cells
-        coords = model.cell_coordinates
-        material = model.mesh.material
-        dofs = node_dofs(cells)
-        sel = self._cells
-        gauss = np.einsum('ga,eai->egi', hex8.shape_functions(hex8.GAUSS_POINTS),
-                          coords[sel])
-        s = stretch(gauss, inner, layer, w)
+    def _assemble(self, s: Optional[np.ndarray], k_weight: complex, beta_weight: complex,
+                  alpha_weight: complex, mass_weight: complex = 0.0) -> sp.csr_matrix:
+        """
+        Return the layer cells' sum of k_w K + beta_w beta K + alpha_w alpha M + mass_w M.
+
+        K and M integrated with the stretch ``s`` at the Gauss points (None: unstretched).
+        """
+        young, poisson, rho = self._elastic
+        alpha, beta = self._rayleigh
 
         def kernel(ids: np.ndarray) -> np.ndarray:
-            e = sel[ids]
-            mat = material[e]
-            young, poisson, rho = mats.young[mat], mats.poisson[mat], mats.density[mat]
-            dk = (hex8.stiffness(coords[e], young, poisson, s[ids])
-                  - hex8.stiffness(coords[e], young, poisson))
-            dm = (hex8.lumped_mass(coords[e], rho, s[ids])
-                  - hex8.lumped_mass(coords[e], rho))
-            out = (1.0 + 1j * w * mats.beta[mat])[:, None, None] * dk
-            diag = ((1j * w * mats.alpha[mat] - w * w)[:, None] * dm).repeat(3, axis=1)
+            part = None if s is None else s[ids]
+            k = hex8.stiffness(self._coords[ids], young[ids], poisson[ids], part)
+            out = (k_weight + beta_weight * beta[ids])[:, None, None] * k
+            m = hex8.lumped_mass(self._coords[ids], rho[ids], part)
+            diag = ((alpha_weight * alpha[ids] + mass_weight)[:, None] * m).repeat(3, axis=1)
             idx = np.arange(24)
             out[:, idx, idx] += diag
             return out
 
-        return assemble_chunked(model.n_dofs, dofs[sel], kernel, dtype=complex).tocsr()
+        return assemble_chunked(self.model.n_dofs, self._dofs, kernel, dtype=complex).tocsr()
 
 
 def symmetry_planes(model: PileSoilModel, load: np.ndarray) -> tuple[MirrorPlane, ...]:
@@ -273,19 +283,18 @@ def symmetry_planes(model: PileSoilModel, load: np.ndarray) -> tuple[MirrorPlane
     has one of the two parities there.
     """
     mesh = model.mesh
-    chosen: list[MirrorPlane] = []
     if model.spec.soil.periodic:
         return ()
+    chosen: list[MirrorPlane] = []
     for axis in ('x', 'y'):
+        try:
+            image = mirror_nodes(mesh.nodes, mesh.cells, mesh.material, axis)
+        except FEError as exc:  # not a symmetric mesh
+            log.debug('no mirror about %s = 0: %s', axis, exc)
+            continue
         for parity in ('symmetric', 'antisymmetric'):
             plane = MirrorPlane(axis, parity)
-            try:
-                t = mirror_reduction(mesh.nodes, mesh.cells, mesh.material,
-                                     tuple(chosen) + (plane,))
-            except Exception as exc:  # not a symmetric mesh
-                log.debug('no mirror about %s = 0: %s', axis, exc)
-                break
-            if load_parity(t, load):
+            if has_parity(load, image, plane):
                 chosen.append(plane)
                 break
     return tuple(chosen)
