@@ -41,7 +41,10 @@ setup(
                       'cholespy>=2.0', 'qdldl>=0.1.7', 'threadpoolctl>=3',
                       # compiled kernels of the lean step (ttb_sim/sim/kernel_registry.py); without
                       # it the numpy twins run.
-                      'numba>=0.59'],
+                      'numba>=0.59',
+                      # `ttb-sim validate V15`'s independent 3-D FE (BSD-3-Clause, pure
+                      # Python: its own hexahedra, quadrature and facet integration)
+                      'scikit-fem>=10'],
     extras_require={
         # ttb-sim sweep --scheduler ADDRESS (a Dask distributed cluster)
         'dask': ['dask[distributed]>=2023.1'],

@@ -198,8 +198,9 @@ class SoilParameters:
     boundary: str = param('viscoelastic', '-', "Sides and base: 'viscoelastic' = springs "
                           'alpha G / R and dashpots rho Vs, rho Vp per unit area ([P] Eq. 3, R '
                           "from the group centre); 'lysmer' = the dashpots only; 'fixed' = "
-                          'base fixed, sides on rollers.',
-                          choices=('viscoelastic', 'lysmer', 'fixed'))
+                          "base fixed, sides on rollers; 'rigid_base' = base fixed under "
+                          'viscous-spring sides (a stratum on bedrock).',
+                          choices=('viscoelastic', 'lysmer', 'fixed', 'rigid_base'))
     alpha_t: float = param(0.67, '-', 'Tangential coefficient of the viscous-spring boundary '
                            '(3-D value of Liu et al.).', low=0.0, high=100.0,
                            low_inclusive=False)

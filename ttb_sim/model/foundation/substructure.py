@@ -328,7 +328,8 @@ def _boundary(spec: Substructure, mesh: Mesh, outer: list[tuple[str, int, np.nda
     Return the free DOFs and the boundary's springs and dashpots (K, C).
 
     ``fixed`` fixes the base and the sides' normal displacement; ``viscoelastic``
-    puts springs and dashpots on the outer faces, ``lysmer`` dashpots only.
+    puts springs and dashpots on the outer faces, ``lysmer`` dashpots only;
+    ``rigid_base`` fixes the base and puts springs and dashpots on the sides.
     """
     soil, piles = spec.soil, spec.piles
     lumping = cast(Lumping, soil.boundary_lumping)
@@ -338,11 +339,11 @@ def _boundary(spec: Substructure, mesh: Mesh, outer: list[tuple[str, int, np.nda
     c_b = sp.csr_matrix((n_dofs, n_dofs))
     for name, f, sel in outer:
         faces = mesh.face_sets[name]
+        if soil.boundary in ('fixed', 'rigid_base') and name == 'zmin':
+            free[node_dofs(mesh.node_sets[name][:, None]).ravel()] = False
+            continue
         if soil.boundary == 'fixed':
-            if name == 'zmin':
-                free[node_dofs(mesh.node_sets[name][:, None]).ravel()] = False
-            else:
-                free[3 * mesh.node_sets[name] + 'xy'.index(name[0])] = False
+            free[3 * mesh.node_sets[name] + 'xy'.index(name[0])] = False
             continue
         lay = mesh.material[sel]
         g = np.array([soil.layers[m].G for m in lay])

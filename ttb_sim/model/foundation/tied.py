@@ -85,7 +85,8 @@ def check_spec(spec: Substructure) -> None:
                               'for a piled pier: cap.enabled = true')
     if spec.soil.boundary == 'lysmer':
         raise FoundationError("soil.boundary = 'lysmer' leaves the block without static "
-                              "support; allowed for a piled pier: 'viscoelastic' or 'fixed'")
+                              "support; allowed for a piled pier: 'viscoelastic', 'fixed' "
+                              "or 'rigid_base'")
 
 
 def tie_cap(model: PileSoilModel) -> TiedSubstructure:

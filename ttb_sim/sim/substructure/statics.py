@@ -71,8 +71,8 @@ def static_solve(model: PileSoilModel, force: np.ndarray, increments: int = 5,
 
     """
     if model.spec.soil.boundary == 'lysmer':
-        raise SimulationError("a static load needs soil.boundary 'viscoelastic' or 'fixed'; "
-                              "'lysmer' (dashpots only) leaves the block floating")
+        raise SimulationError("a static load needs soil.boundary 'viscoelastic', 'fixed' or "
+                              "'rigid_base'; 'lysmer' (dashpots only) leaves the block floating")
     free = np.flatnonzero(model.free)
     k_lin = model.linear_stiffness()
     k_lin_free = k_lin[free][:, free]

@@ -13,7 +13,9 @@
 # limitations under the License.
 
 """
-Pile-soil validation cases V11-V16 (VALIDATION.md) and the mesh convergence check.
+Pile-soil validation cases V11-V14, V16 (VALIDATION.md) and the mesh convergence check.
+
+V15, the pile group, is in :mod:`.pile_group`.
 
 Each case builds its substructure from the records users give
 (:mod:`ttb_sim.model.foundation.records` -> :func:`~ttb_sim.model.foundation.substructure.build`)
@@ -39,11 +41,6 @@ V14  Single pile d = 1.0 m (0.886 m square), L = 12 m, E = 1e11 Pa in the
      (its springs stand for the half-space beyond), h = 0.443 m growing by
      1.3 to 3 m, Desai interface; static head stiffness under 1 kN against
      Randolph-Wroth (layered form, 4.96e7 N/m).
-V15  pile_harmonic: 5 x 3 group (3 m spacing, d = 1.0 m, L = 12 m), Table 5
-     soil, 10 kN at 20 Hz vertical on pile 5, ground between piles 4 and 5;
-     steady amplitudes (reported) and the frequency of the low-frequency
-     transient (fitted damped cosine after removing the 20 Hz harmonics)
-     against [P]'s 1.2 Hz (10 %).
 V16  Desai law of the V14 model at a shaft Gauss point of the middle layer,
      sheared monotonically at its geostatic normal stress: max of tau / tau_f
      (must not exceed 1 + 1e-6) and the largest relative error of stress and
@@ -59,7 +56,6 @@ from typing import Optional, Sequence
 
 import numpy as np
 import scipy.linalg as sla
-from scipy.optimize import curve_fit
 
 from ttb_sim.config import load_scenario, Scenario
 from ttb_sim.model.foundation.records import (BlockSize, EQUAL_AREA_SIDE, MeshSize, Observation,
@@ -225,63 +221,6 @@ def split_response(t: np.ndarray, x: np.ndarray, frequency: float
     return float(np.hypot(*coef)), slow
 
 
-def transient_frequency(t: np.ndarray, slow: np.ndarray) -> float:
-    """
-    Return the frequency (Hz) of a damped cosine plus offset fitted to a slow record.
-
-    The fit starts from the spectral peak between 0.3 and 5 Hz; when it lands
-    outside that band (no damped oscillation in the record) the spectral peak
-    is returned.
-    """
-    def model(tt: np.ndarray, a: float, zeta: float, f: float, phase: float,
-              c: float) -> np.ndarray:
-        w = 2 * math.pi * f
-        return a * np.exp(-zeta * w * tt) * np.cos(w * tt + phase) + c
-
-    spectrum = np.abs(np.fft.rfft((slow - slow.mean()) * np.hanning(len(slow)), 16 * len(t)))
-    freqs = np.fft.rfftfreq(16 * len(t), t[1] - t[0])
-    band = (freqs > 0.3) & (freqs < 5.0)
-    guess = float(freqs[band][np.argmax(spectrum[band])])
-    p0 = [float(np.ptp(slow)) / 2, 0.1, guess, 0.0, float(slow.mean())]
-    try:
-        p, _ = curve_fit(model, t, slow, p0=p0, maxfev=20000)
-    except RuntimeError:  # pragma: no cover - fall back on the spectral peak
-        return guess
-    fitted = float(abs(p[2]))
-    # a record without a damped oscillation (a single decaying hump) fits a near-zero
-    # frequency: report the spectral peak of the searched band instead
-    return fitted if 0.3 < fitted < 5.0 else guess
-
-
-def v15_results(overrides: Sequence[str] = ()) -> dict[str, float]:
-    """Run the built-in pile_harmonic and return amplitudes and transient frequencies."""
-    scenario = load_scenario('pile_harmonic', overrides)
-    runner, frames = scenario_frames(scenario)
-    model = runner.model
-    t = np.array([f.time for f in frames])
-    pile = np.array([f.pile_displacement[scenario.load.pile - 1, 2] for f in frames])
-    ground = np.array([f.soil_points[-1, 5] for f in frames])  # the user point, uz
-    amp_p, slow_p = split_response(t, pile, 20.0)
-    amp_g, slow_g = split_response(t, ground, 20.0)
-    return {'pile_amplitude': amp_p, 'ground_amplitude': amp_g,
-            'pile_transient_hz': transient_frequency(t, slow_p),
-            'ground_transient_hz': transient_frequency(t, slow_g),
-            'pile_peak': float(np.abs(pile).max()), 'ground_peak': float(np.abs(ground).max()),
-            'dofs': float(model.n_dofs)}
-
-
-def v15() -> list[Row]:
-    """[P]'s 10 kN, 20 Hz check on pile 5."""
-    r = v15_results()
-    rows = [Row('V15', 'pile 5 head amplitude (20 Hz)', r['pile_amplitude'], 0.0, 0.0, 0.0,
-                True, 'm', 'report'),
-            Row('V15', 'ground amplitude (20 Hz)', r['ground_amplitude'], 0.0, 0.0, 0.0,
-                True, 'm', 'report'),
-            relative_row('V15', 'pile transient frequency', r['pile_transient_hz'], 1.2, 0.10,
-                         'Hz')]
-    return rows
-
-
 def desai_monotonic(n: int = 2001, gauss_point: Optional[int] = None
                     ) -> tuple[float, float, float]:
     """
@@ -401,8 +340,6 @@ PILE_SOIL_CASES = (
     Case('V12', "[P]'s three-layer deposit: second shear-column mode", v12),
     Case('V13', 'viscous-spring boundary: energy reflected by the base', v13),
     Case('V14', 'single pile: static head stiffness vs Randolph-Wroth (about 1 min)', v14),
-    Case('V15', "[P]'s 10 kN 20 Hz check on pile 5: amplitudes, transient (about 5 min "
-         'of CPU, 3 GiB)', v15),
     Case('V16', 'Desai interface under monotonic shear', v16),
 )
 """The pile-soil cases, registered with the validation suite."""
