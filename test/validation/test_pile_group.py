@@ -33,7 +33,8 @@ from ttb_sim.model.foundation.frequency_response import frequency_response
 from ttb_sim.model.foundation.records import SoilLayer
 from ttb_sim.model.foundation.substructure import build
 from ttb_sim.validation.cases.pile_group import (amplitude_rows, AMPLITUDE_TOLERANCE,
-                                                 stratum_frequencies, transient_frequency)
+                                                 HarmonicRecord, stratum_frequencies,
+                                                 transient_frequency, transient_rows)
 from ttb_sim.validation.references.independent_fe import (cell_materials, IndependentBlock,
                                                           skfem_cells)
 
@@ -76,7 +77,7 @@ def test_independent_fe_consistent_boundary_matrices():
 
 def test_time_domain_amplitudes_match_the_independent_fe():
     """V15's amplitude rows on the pair: the time-domain run users make within 5 %."""
-    rows = amplitude_rows(PAIR, desai=False)
+    rows = amplitude_rows(PAIR)
     assert [r.passed for r in rows] == [True, True], rows
     assert all(r.tolerance == AMPLITUDE_TOLERANCE and r.reference > 0 for r in rows)
 
@@ -124,3 +125,19 @@ def test_transient_fit_recovers_a_damped_cosine():
     t = np.arange(0.0, 4.0, 1e-3)
     slow = 3e-6 * np.exp(-0.05 * 2 * math.pi * 0.73 * t) * np.cos(2 * math.pi * 0.73 * t + 0.4)
     assert transient_frequency(t, slow + 1e-6) == pytest.approx(0.73, rel=0.01)
+
+
+def _record(ground_hz):
+    return HarmonicRecord(1e-5, 1e-5, 1.0, ground_hz, 0, np.zeros((0, 3)), np.zeros((0, 8)))
+
+
+def test_transient_rows_judge_only_the_rigid_base_options():
+    layers = load_scenario('pile_harmonic').soil.layers
+    first = stratum_frequencies(layers)['vertical'][0]
+    runs = {'viscoelastic': _record(3.0), 'lysmer': _record(3.0), 'fixed': _record(first * 1.05),
+            'rigid_base': _record(first * 1.2)}
+    rows = {r.quantity: r for r in transient_rows(layers, runs)}
+    assert rows['ground transient, fixed'].passed
+    assert not rows['ground transient, rigid_base'].passed
+    assert rows['ground transient, viscoelastic'].error_kind == 'report'
+    assert rows['stratum vertical mode 1 (closed form)'].computed == pytest.approx(first)
