@@ -52,7 +52,7 @@ def test_bad_frequencies_are_named(text: str, match: str) -> None:
 
 
 @pytest.mark.parametrize('args, match', [
-    (['frf', 'moving_force_beam'], 'not a pile-soil substructure run'),
+    (['frf', 'moving_force_beam'], 'neither a pile-soil substructure run'),
     (['frf', 'single_pile', '--freqs', 'x'], "'x' is not a number"),
     (['frf', 'single_pile', '--pml', '-1'], '--pml = -1'),
     (['frf', 'single_pile', '--pml', '2', '--freqs', '0,1'], 'above 0 Hz'),

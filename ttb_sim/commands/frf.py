@@ -122,12 +122,31 @@ def _case(spec: Any, load: Any, freqs: list[float], pml: Optional[float], solver
     layer = MatchedLayer(pml) if pml is not None else None
     r = substructure_response(spec, load, freqs, layer=layer, method=solver, progress=progress)
     axis = 'xyz'.index(load.direction)
-    head = r.heads[:, load.pile - 1, axis] if load.target == 'pile' else \
+    head = r.heads[:, load.pile - 1, axis] if load.target in ('pile', 'cap') else \
         np.full(len(freqs), np.nan + 0j)
     return {'label': label, 'dofs': r.dofs, 'unknowns': r.unknowns, 'solver': r.method,
             'symmetry': [f'{p.axis} {p.parity}' for p in r.symmetry],
             'seconds': r.seconds, 'head': head,
             'points': {name: r.points[:, k, axis] for k, name in enumerate(r.point_names)}}
+
+
+def _pier_load(loaded: Any) -> Any:
+    """
+    Return the load of a bridge scenario's piled piers: 1 N on the cap top, central pile seen.
+
+    Every piled pier of a scenario stands on the same substructure; the force
+    acts along ``load.direction`` as a uniform pressure on the cap top.
+    """
+    from ttb_sim.model.foundation.records import PileLoad
+
+    piled = loaded.foundation.piled if loaded.foundation.model == 'piled' else ()
+    if not piled:
+        raise ScenarioError(f"load.type = 'none': {loaded.name} is neither a pile-soil "
+                            'substructure run nor a bridge on piled piers; allowed: a scenario '
+                            'with load.type static, harmonic or pulse (e.g. single_pile, '
+                            'pile_harmonic), or foundation.model: piled (e.g. paper_ttbcpsi)')
+    return PileLoad('static', 1.0, pile=loaded.piles.count // 2 + 1,
+                    direction=loaded.load.direction, target='cap')
 
 
 def frf_report(scenario: str | Path, freqs: Sequence[float], *, pml: Optional[float] = None,
@@ -150,12 +169,8 @@ def frf_report(scenario: str | Path, freqs: Sequence[float], *, pml: Optional[fl
     from ttb_sim.config import load_scenario
 
     loaded = load_scenario(scenario, overrides)
-    if not loaded.substructure_only:
-        raise ScenarioError(f"load.type = 'none': {loaded.name} is not a pile-soil "
-                            'substructure run; allowed: a scenario with load.type static, '
-                            'harmonic or pulse (e.g. single_pile, pile_harmonic)')
     spec = loaded.substructure('pier01')
-    load = loaded.load
+    load = loaded.load if loaded.substructure_only else _pier_load(loaded)
     values = [float(f) for f in freqs]
     if pml is not None and min(values) <= 0:
         raise ScenarioError('--freqs: a perfectly matched layer (--pml) needs frequencies '
@@ -182,8 +197,9 @@ def format_frf(report: dict[str, Any]) -> str:
     """Return the report as a terminal table."""
     cases = report['cases']
     load = report['load']
+    where = ' under a force on the cap top' if load['target'] == 'cap' else ''
     head = [f'{report["scenario"]}: receptance of pile {load["pile"]}\'s head along '
-            f'{load["direction"]} (m/N), far field {report["far_field"]}']
+            f'{load["direction"]}{where} (m/N), far field {report["far_field"]}']
     for c in cases:
         head.append(f'  {c["label"]}: {c["dofs"]} DOFs, {c["unknowns"]} unknowns '
                     f'(symmetry: {", ".join(c["symmetry"]) or "none"}), {c["solver"]}, '

@@ -185,3 +185,45 @@ def test_bad_requests_are_refused(pile: PileSoilModel) -> None:
         MatchedLayer(0.0)
     with pytest.raises(FoundationError, match='reflection'):
         MatchedLayer(2.0, reflection=1.5)
+
+
+CAPPED = ('soil.block.lx=21', 'soil.block.ly=15', 'soil.mesh.h=1.0', 'soil.mesh.h_max=4.0',
+          'soil.mesh.h_shaft=2.0')
+"""The piled pier of ``paper_ttbcpsi`` (15 x 9 x 2.5 m cap on 3 x 5 piles) on a coarse block."""
+
+
+@pytest.fixture(scope='module')
+def capped() -> PileSoilModel:
+    from ttb_sim.config import load_scenario
+    return build(load_scenario('paper_ttbcpsi', CAPPED).substructure())
+
+
+def test_cap_load_is_a_uniform_pressure_on_the_cap_top(capped: PileSoilModel) -> None:
+    load = PileLoad('static', 2.0e3, pile=8, direction='z', target='cap')
+    f = capped.load_vector(load)
+    top = capped.spec.cap.thickness
+    loaded = np.flatnonzero(f)
+    assert np.all(loaded % 3 == 2)
+    assert np.allclose(capped.mesh.nodes[loaded // 3, 2], top)
+    assert f.sum() == pytest.approx(2.0e3, rel=1e-12)
+    # the first moments vanish about the cap centre: the resultant acts there
+    xy = capped.mesh.nodes[loaded // 3, :2]
+    assert np.abs(f[loaded] @ xy).max() < 1e-9 * 2.0e3 * 15.0
+
+
+def test_cap_load_zero_frequency_is_the_static_solution(capped: PileSoilModel) -> None:
+    load = PileLoad('static', 1.0, pile=8, direction='z', target='cap')
+    got = frequency_response(capped, load, [0.0], method='superlu')
+    planes = tuple(f'{p.axis} {p.parity}' for p in got.symmetry)
+    assert planes == ('x symmetric', 'y symmetric')
+    k = (capped.linear_stiffness() + capped.initial_interface_stiffness()).tocsc()
+    free = np.flatnonzero(capped.free)
+    u = np.zeros(capped.n_dofs)
+    u[free] = spla.spsolve(k[free][:, free], capped.load_vector(load)[free])
+    static = (capped.head_displacement @ u)[3 * 7 + 2]
+    assert got.heads[0, 7, 2].real == pytest.approx(static, rel=1e-8)
+
+
+def test_cap_load_needs_a_cap() -> None:
+    with pytest.raises(FoundationError, match="load.target = 'cap' needs a cap"):
+        build(small_pile(), PileLoad('static', 1.0, pile=1, target='cap'))

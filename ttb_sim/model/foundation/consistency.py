@@ -77,7 +77,10 @@ def check_substructure(spec: Substructure, load: Optional[PileLoad] = None) -> N
                 f'allowed: |x| <= {0.5 * soil.lx:g}, |y| <= {0.5 * soil.ly:g}, '
                 f'{-soil.depth:g} <= z <= {top:g} m (soil.block.lx, soil.block.ly, soil.layers)')
     if load is not None and load.type != 'none':
-        if load.target == 'pile':
+        if load.target == 'cap' and not (spec.cap.enabled and piles is not None):
+            raise FoundationError("load.target = 'cap' needs a cap; allowed: cap.enabled = "
+                                  "true (with piles), or load.target 'pile' or 'surface'")
+        if load.target in ('pile', 'cap'):
             count = piles.count if piles is not None else 0
             if load.pile > count:
                 message = f'load.pile = {load.pile!r}; allowed: 1 .. {count} (piles in group)'

@@ -118,6 +118,17 @@ def surface_weights(cut: GridCells, kind: np.ndarray, cells: np.ndarray,
     return _tributary(faces, weights, n_nodes)
 
 
+def cap_top_weights(nodes: np.ndarray, cells: np.ndarray, kind: np.ndarray,
+                    top: float) -> np.ndarray:
+    """Return the tributary area of the cap-top nodes (z = ``top``), shape (n_nodes,) (m^2)."""
+    faces = cells[kind == CAP][:, HEX_FACES[_TOP]]
+    faces = faces[np.all(np.abs(nodes[faces][..., 2] - top) <= 1e-9 * max(1.0, top), axis=1)]
+    if len(faces) == 0:
+        return np.zeros(len(nodes))
+    _, weights = face_frames(nodes[faces])
+    return _tributary(faces, weights, len(nodes))
+
+
 def _positions(spec: Substructure) -> tuple[list[tuple[float, float, float]], list[str]]:
     """Return the positions and names of the soil points ``spec.observation`` asks for."""
     obs, piles = spec.observation, spec.piles

@@ -387,8 +387,9 @@ class PileLoad:
                       'fastest).', low=1, high=2500)
     direction: str = param('z', '-', 'Direction of the force.', choices=('x', 'y', 'z'))
     target: str = param('pile', '-', "'pile': a uniform pressure on the pile head; "
-                        "'surface': on the whole ground surface.",
-                        choices=('pile', 'surface'))
+                        "'surface': on the whole ground surface; 'cap': on the cap top "
+                        '(load.pile is then the pile whose head is reported).',
+                        choices=('pile', 'surface', 'cap'))
 
     def __post_init__(self) -> None:
         """Check every field against its declaration."""

@@ -60,8 +60,8 @@ from ttb_sim.fe.quad import FACE_N
 from ttb_sim.model.constants import GRAVITY
 from ttb_sim.model.foundation.consistency import check_substructure
 from ttb_sim.model.foundation.desai import DesaiLaw, initial_moduli
-from ttb_sim.model.foundation.observation import (head_operators, soil_points, SoilPoints,
-                                                  surface_weights)
+from ttb_sim.model.foundation.observation import (cap_top_weights, head_operators,
+                                                  soil_points, SoilPoints, surface_weights)
 from ttb_sim.model.foundation.records import PileLoad, Substructure
 from ttb_sim.model.foundation.soil_mesh import (CAP, CellTags, check_aspect, InterfaceSplit,
                                                 PILE, SOIL, soil_grid, split_interface,
@@ -169,9 +169,16 @@ class PileSoilModel:
         A pile load is a uniform pressure on the pile head of total force
         ``load.amplitude`` (nodal forces proportional to the tributary areas,
         i.e. the transpose of the head-displacement operator times the force);
-        a surface load is a uniform pressure on the whole ground surface.
+        a surface load is a uniform pressure on the whole ground surface, a cap
+        load one on the cap top.
         """
         axis = 'xyz'.index(load.direction)
+        if load.target == 'cap':
+            w = cap_top_weights(self.mesh.nodes, self.mesh.cells, self.cell_kind,
+                                self.spec.cap.thickness)
+            f = np.zeros(self.n_dofs)
+            f[axis::3] = load.amplitude * w / w.sum()
+            return f
         if load.target == 'pile':
             row = 3 * (load.pile - 1) + axis
             f = np.asarray(self.head_displacement[row].toarray()).ravel()

@@ -226,6 +226,8 @@ def transient_rows(layers: Sequence[SoilLayer], runs: Mapping[str, HarmonicRecor
             for k, f in enumerate(closed['shear'])]
     rows += [report_row(f'stratum vertical mode {k + 1} (closed form)', float(f), float(f),
                         'Hz') for k, f in enumerate(closed['vertical'])]
+    rows.append(report_row("[P]'s transient: V12's 2nd shear mode", float(closed['shear'][1]),
+                           PAPER_TRANSIENT_HZ, 'Hz'))
     first = float(closed['vertical'][0])
     for boundary, run in runs.items():
         label = f'ground transient, {boundary}'
