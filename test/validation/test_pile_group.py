@@ -127,8 +127,8 @@ def test_transient_fit_recovers_a_damped_cosine():
     assert transient_frequency(t, slow + 1e-6) == pytest.approx(0.73, rel=0.01)
 
 
-def _record(ground_hz):
-    return HarmonicRecord(1e-5, 1e-5, 1.0, ground_hz, 0, np.zeros((0, 3)), np.zeros((0, 8)))
+def _record(pile_hz):
+    return HarmonicRecord(1e-5, 1e-5, pile_hz, 2.0, 0, np.zeros((0, 3)), np.zeros((0, 8)))
 
 
 def test_transient_rows_judge_only_the_rigid_base_options():
@@ -137,7 +137,8 @@ def test_transient_rows_judge_only_the_rigid_base_options():
     runs = {'viscoelastic': _record(3.0), 'lysmer': _record(3.0), 'fixed': _record(first * 1.05),
             'rigid_base': _record(first * 1.2)}
     rows = {r.quantity: r for r in transient_rows(layers, runs)}
-    assert rows['ground transient, fixed'].passed
-    assert not rows['ground transient, rigid_base'].passed
-    assert rows['ground transient, viscoelastic'].error_kind == 'report'
+    assert rows['pile transient, fixed'].passed
+    assert not rows['pile transient, rigid_base'].passed
+    assert rows['pile transient, viscoelastic'].error_kind == 'report'
+    assert rows['ground transient, fixed'].error_kind == 'report'
     assert rows['stratum vertical mode 1 (closed form)'].computed == pytest.approx(first)

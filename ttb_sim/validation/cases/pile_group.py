@@ -32,10 +32,10 @@ from rest leaves (a damped cosine fitted to the load-period moving average)
 for each boundary option, beside the closed-form frequencies of the 22 m
 stratum on a rigid base (layer transfer matrices: shear modes with G,
 vertical ones with the constrained modulus). Where the base is rigid
-(``fixed``, ``rigid_base``) the stratum's first vertical mode is the
-domain's, and the transient must lie within 10 % of it; with an absorbing
-base (``viscoelastic``, ``lysmer``) the stratum has no resonance and the
-fit is reported. [P]'s 1.2 Hz (Fig. 10; [P] states neither its block nor
+(``fixed``, ``rigid_base``; runs of 4 s) the stratum's first vertical
+mode is the domain's, and the loaded pile's transient must lie within 10 %
+of it; with an absorbing base (``viscoelastic``, ``lysmer``) the stratum
+has no resonance and the fit is reported. [P]'s 1.2 Hz (Fig. 10; [P] states neither its block nor
 its boundary) is reported, not a target: the model's counterpart is V12,
 the deposit's second shear mode (1.27 Hz).
 """
@@ -68,6 +68,8 @@ BOUNDARIES = ('viscoelastic', 'lysmer', 'fixed', 'rigid_base')
 """The boundary options of the transient table."""
 RIGID_BASE = ('fixed', 'rigid_base')
 """Boundary options under which the stratum has its own resonances."""
+RINGING_SECONDS = 4.0
+"""Duration (s) of the rigid-base runs."""
 PAPER_TRANSIENT_HZ = 1.2
 """[P] Fig. 10's transient (reported only)."""
 
@@ -208,9 +210,19 @@ def stratum_frequencies(layers: Sequence[SoilLayer], n: int = 2) -> dict[str, np
 
 def boundary_runs(overrides: Sequence[str] = (), boundaries: Sequence[str] = BOUNDARIES
                   ) -> dict[str, HarmonicRecord]:
-    """Run the scenario once per boundary option (its own interface); records by option."""
-    return {b: harmonic_run(load_scenario('pile_harmonic', [*overrides, f'soil.boundary={b}']))
-            for b in boundaries}
+    """
+    Run the scenario once per boundary option (its own interface); records by option.
+
+    Under a rigid base the stratum rings for several seconds: those runs last
+    :data:`RINGING_SECONDS` (about three periods of its first vertical mode),
+    the others the scenario's own duration.
+    """
+    runs = {}
+    for b in boundaries:
+        longer = [f'solver.duration={RINGING_SECONDS:g}'] if b in RIGID_BASE else []
+        runs[b] = harmonic_run(load_scenario('pile_harmonic',
+                                             [*overrides, f'soil.boundary={b}', *longer]))
+    return runs
 
 
 def transient_rows(layers: Sequence[SoilLayer], runs: Mapping[str, HarmonicRecord]
@@ -218,8 +230,10 @@ def transient_rows(layers: Sequence[SoilLayer], runs: Mapping[str, HarmonicRecor
     """
     Rows of the low-frequency transient per boundary option, beside the stratum's frequencies.
 
-    Under a rigid base the ground point's transient must lie within 10 % of
-    the stratum's first vertical frequency; otherwise it is reported.
+    Under a rigid base the loaded pile head's transient must lie within 10 %
+    of the stratum's first vertical frequency; otherwise it is reported. The
+    ground point's is reported: midway between two piles it also carries
+    the block's higher modes.
     """
     closed = stratum_frequencies(layers)
     rows = [report_row(f'stratum shear mode {k + 1} (closed form)', float(f), float(f), 'Hz')
@@ -230,14 +244,14 @@ def transient_rows(layers: Sequence[SoilLayer], runs: Mapping[str, HarmonicRecor
                            PAPER_TRANSIENT_HZ, 'Hz'))
     first = float(closed['vertical'][0])
     for boundary, run in runs.items():
-        label = f'ground transient, {boundary}'
+        label = f'pile transient, {boundary}'
         if boundary in RIGID_BASE:
-            rows.append(relative_row('V15', label, run.ground_transient_hz, first,
+            rows.append(relative_row('V15', label, run.pile_transient_hz, first,
                                      TRANSIENT_TOLERANCE, 'Hz'))
         else:
-            rows.append(report_row(label, run.ground_transient_hz, first, 'Hz'))
-        rows.append(report_row(f'pile transient, {boundary}', run.pile_transient_hz,
-                               PAPER_TRANSIENT_HZ, 'Hz'))
+            rows.append(report_row(label, run.pile_transient_hz, first, 'Hz'))
+        rows.append(report_row(f'ground transient, {boundary}', run.ground_transient_hz,
+                               first, 'Hz'))
     return rows
 
 
@@ -251,6 +265,6 @@ def v15(overrides: Sequence[str] = ()) -> list[Row]:
 
 PILE_GROUP_CASES = (
     Case('V15', "[P]'s 10 kN 20 Hz check on pile 5: amplitudes against an independent FE "
-         '(scikit-fem), transient per boundary option (about 40 min of CPU, 8 GiB)', v15),
+         '(scikit-fem), transient per boundary option (about 1 h of CPU, 8 GiB)', v15),
 )
 """The pile-group case, registered with the validation suite."""
