@@ -72,7 +72,7 @@ class BlockResponse:
     points : array of complex, shape (n_points, 3)
         Displacement at each observation point per unit force (m/N).
     dofs : int
-        Unknowns solved (free DOFs).
+        Unknowns solved (free DOFs, summed over the parities solved).
 
     """
 
@@ -329,16 +329,80 @@ class IndependentBlock:
         probes = self.basis.probes(np.asarray(points, dtype=float).T)
         return sp.csr_matrix(probes)
 
+    def parity_bases(self) -> list[sp.csr_matrix]:
+        """
+        Return the bases T of the four mirror parities of the mesh about the group centre.
+
+        The planes x = x_c and y = y_c through the pile group's centre; each T
+        (N x n_p, entries 0 and +-1, up to 4 on a node in both planes) spans the
+        displacement fields symmetric or antisymmetric about each plane, and the
+        four together span every field. A mesh that its mirrors do not map onto
+        itself gives the identity alone.
+        """
+        from scipy.spatial import cKDTree  # noqa: I202
+
+        p = self.mesh.p.T
+        piles = self.spec.piles
+        centre = np.array(piles.centre) if piles is not None else np.zeros(2)
+        scale = float(np.ptp(p, axis=0).max())
+        tree = cKDTree(p)
+        images = []
+        for axis in (0, 1):
+            mirrored = p.copy()
+            mirrored[:, axis] = 2.0 * centre[axis] - p[:, axis]
+            dist, idx = tree.query(mirrored)
+            if dist.max() > 1e-9 * scale:
+                return [sp.identity(self.basis.N, format='csr')]
+            images.append(idx)
+        mx, my = images
+        rep = np.flatnonzero((p[:, 0] >= centre[0] - 1e-9 * scale)
+                             & (p[:, 1] >= centre[1] - 1e-9 * scale))
+        out = []
+        for px in (1.0, -1.0):
+            for py in (1.0, -1.0):
+                # a field symmetric about x = x_c flips u_x in the mirror, keeps u_y, u_z
+                sx = px * np.array([-1.0, 1.0, 1.0])
+                sy = py * np.array([1.0, -1.0, 1.0])
+                rows, cols, vals = [], [], []
+                column = 3 * np.arange(len(rep))[:, None] + np.arange(3)
+                for nodes, sign in ((rep, np.ones(3)), (mx[rep], sx), (my[rep], sy),
+                                    (mx[my[rep]], sx * sy)):
+                    rows.append((3 * nodes[:, None] + np.arange(3)).ravel())
+                    cols.append(column.ravel())
+                    vals.append(np.tile(sign, len(rep)))
+                t = sp.csc_matrix((np.concatenate(vals), (np.concatenate(rows),
+                                                          np.concatenate(cols))),
+                                  shape=(self.basis.N, 3 * len(rep)))
+                t.eliminate_zeros()
+                out.append(t[:, np.flatnonzero(np.diff(t.indptr))].tocsr())
+        return out
+
     def response(self, frequency: float, load: np.ndarray, head: np.ndarray,
                  points: np.ndarray, method: str = 'auto') -> BlockResponse:
-        """Solve (K + i w C - w^2 M) u = load at ``frequency``; return head and point values."""
+        """
+        Solve (K + i w C - w^2 M) u = load at ``frequency``; return head and point values.
+
+        The solution is the sum of its four mirror-parity parts
+        (:meth:`parity_bases`), each solved on its own quarter-size subspace
+        (T^T Z T q = T^T F: exact, as Z commutes with the mirrors).
+        """
         w = 2.0 * math.pi * frequency
         free = np.setdiff1d(np.arange(self.basis.N), self.fixed)
         z = (self.stiffness + 1j * w * self.damping - w * w * self.mass).tocsr()
         z = z[free][:, free]
+        f = load[free].astype(complex)
         u = np.zeros(self.basis.N, dtype=complex)
-        u[free] = factorize_complex(z.tocsc(), method=method).solve(load[free].astype(complex))
+        unknowns = 0
+        for basis in self.parity_bases():
+            t = basis[free]
+            t = t[:, np.flatnonzero(np.diff(t.tocsc().indptr))].tocsr()
+            rhs = t.T @ f
+            if np.abs(rhs).max(initial=0.0) <= 1e-12 * np.abs(f).max(initial=0.0):
+                continue  # the load has no part of this parity (round-off aside)
+            reduced = (t.T @ z @ t).tocsc()
+            u[free] += t @ factorize_complex(reduced, method=method).solve(rhs)
+            unknowns += t.shape[1]
         probes = self.point_operator(points) if len(points) else None
         # probes rows are grouped by component: (u^1 at all points, u^2 ..., u^3 ...)
         values = (probes @ u).reshape(3, -1).T if probes is not None else np.zeros((0, 3))
-        return BlockResponse(frequency, complex(head @ u), values, len(free))
+        return BlockResponse(frequency, complex(head @ u), values, unknowns)
