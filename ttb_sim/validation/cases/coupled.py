@@ -291,7 +291,7 @@ def window_spectra(record: PileRecord, response: PileResponse
     lines = np.searchsorted(response.frequencies, f[inside])
     if not np.allclose(response.frequencies[np.minimum(lines, response.frequencies.size - 1)],
                        f[inside]):
-        raise ValueError('the pile response was not solved on the record\'s lines')
+        raise ValueError("the pile response was not solved on the record's lines")
     sub = PileResponse(f[inside], response.pier_top[lines], response.girder[lines],
                        response.positions)
     sc = record.scenario
