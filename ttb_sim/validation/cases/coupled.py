@@ -61,8 +61,9 @@ from ttb_sim.config import load_scenario, Scenario
 from ttb_sim.model.constants import GRAVITY
 from ttb_sim.sim import Simulation
 from ttb_sim.validation.cases.pile_spectrum import (coupled_bridge, fourier_spectrum,
-                                                    moving_load_spectrum, pile_response,
-                                                    PileResponse, SPECTRUM_STEP, window_lines)
+                                                    moving_load_spectrum, padded_length,
+                                                    pile_response, PileResponse,
+                                                    spectrum_energy, window_lines)
 from ttb_sim.validation.references.moving_load import passage_times, pier_load_spectrum
 from ttb_sim.validation.rows import Case, Row
 
@@ -338,7 +339,7 @@ def spectrum_rows(record: PileRecord, response: PileResponse) -> list[Row]:
     """
     f, run, product, girders = window_spectra(record, response)
     df = float(f[1] - f[0])
-    e_run, e_hr, e_g = (2.0 * float(np.sum(np.abs(x) ** 2)) * df for x in (run, product, girders))
+    e_run, e_hr, e_g = (spectrum_energy(x, df) for x in (run, product, girders))
     error = abs(energy_db(e_run, e_hr))
     v = record.speed_kmh
     return [Row('V20', f'car-line window energy vs H R, {v:g} km/h', e_run, e_hr, error,
@@ -373,8 +374,7 @@ def response_lines(records: Sequence[PileRecord]) -> np.ndarray:
     """Return the union of the records' spectral lines between their car lines (Hz)."""
     lines = []
     for r in records:
-        f = np.fft.rfftfreq(max(r.acceleration.size, int(round(r.rate / SPECTRUM_STEP))),
-                            1.0 / r.rate)
+        f = np.fft.rfftfreq(padded_length(r.acceleration.size, r.rate), 1.0 / r.rate)
         lines.append(f[window_lines(f, harmonic_window(r.scenario, r.duration))])
     return np.unique(np.concatenate(lines))
 

@@ -109,11 +109,16 @@ def pile_response(structure: Structure, frequencies: np.ndarray, pile: int) -> P
     return PileResponse(f, at_top, along, positions)
 
 
+def padded_length(size: int, rate: float, step: float = SPECTRUM_STEP) -> int:
+    """Return the FFT length of a record of ``size`` samples: lines ``step`` apart, or closer."""
+    return max(size, int(round(rate / step)))
+
+
 def fourier_spectrum(signal: np.ndarray, rate: float, step: float = SPECTRUM_STEP
                      ) -> tuple[np.ndarray, np.ndarray]:
     """Return (f Hz, X(f) = int x exp(-i 2 pi f t) dt) of a record, zero-padded to ``step``."""
     x = np.asarray(signal, dtype=float)
-    n = max(x.size, int(round(rate / step)))
+    n = padded_length(x.size, rate, step)
     return np.fft.rfftfreq(n, 1.0 / rate), np.fft.rfft(x, n) / rate
 
 
@@ -122,10 +127,9 @@ def window_lines(f: np.ndarray, window: tuple[float, float]) -> np.ndarray:
     return np.flatnonzero((f > window[0]) & (f < window[1]))
 
 
-def window_energy(f: np.ndarray, spectrum: np.ndarray, window: tuple[float, float]) -> float:
-    """Return 2 int |X|^2 df over ``window``: the record's energy there (one-sided, Parseval)."""
-    inside = window_lines(f, window)
-    return float(2.0 * np.sum(np.abs(spectrum[inside]) ** 2) * (f[1] - f[0]))
+def spectrum_energy(spectrum: np.ndarray, df: float) -> float:
+    """Return 2 sum |X|^2 df: the energy int x^2 dt of the lines given (one-sided, Parseval)."""
+    return float(2.0 * np.sum(np.abs(spectrum) ** 2) * df)
 
 
 def moving_load_spectrum(response: PileResponse, speed: float, loads: np.ndarray,
