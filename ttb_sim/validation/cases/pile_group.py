@@ -265,6 +265,7 @@ def v15(overrides: Sequence[str] = ()) -> list[Row]:
 
 PILE_GROUP_CASES = (
     Case('V15', "[P]'s 10 kN 20 Hz check on pile 5: amplitudes against an independent FE "
-         '(scikit-fem), transient per boundary option (about 1 h of CPU, 8 GiB)', v15),
+         '(scikit-fem), transient per boundary option (about 1 h of CPU, 9 GB; the '
+         "independent solve needs MKL PARDISO: pip install 'ttb_sim[pardiso]')", v15),
 )
 """The pile-group case, registered with the validation suite."""
