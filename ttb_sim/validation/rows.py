@@ -42,6 +42,17 @@ def relative_row(case: str, quantity: str, computed: float, reference: float,
     return Row(case, quantity, computed, reference, error, tolerance, error <= tolerance, unit)
 
 
+def report_row(case: str, quantity: str, computed: float, unit: str = '',
+               reference: float = 0.0) -> Row:
+    """
+    Build an information row: judged by nothing, so it always passes.
+
+    With a nonzero ``reference`` its relative difference is shown as the error.
+    """
+    error = abs(computed - reference) / abs(reference) if reference else 0.0
+    return Row(case, quantity, computed, reference, error, 0.0, True, unit, 'report')
+
+
 @dataclass(frozen=True)
 class Case:
     """A validation case: an id, a title and a function producing rows."""

@@ -66,7 +66,7 @@ from ttb_sim.validation.cases.pile_spectrum import (coupled_bridge, fourier_spec
                                                     pile_response, PileResponse,
                                                     spectrum_energy, window_lines)
 from ttb_sim.validation.references.moving_load import passage_times, pier_load_spectrum
-from ttb_sim.validation.rows import Case, Row
+from ttb_sim.validation.rows import Case, report_row, Row
 
 COUPLING_TOLERANCE = 0.01
 """V17, V18: largest RMS difference, relative to the reference run's RMS."""
@@ -242,11 +242,6 @@ def in_range(centre: float, bounds: tuple[float, float]) -> bool:
     return bounds[0] * 0.98 <= centre <= bounds[1] * 1.02
 
 
-def report_row(quantity: str, value: float, unit: str) -> Row:
-    """Return an information row (always 'pass', judged by nothing)."""
-    return Row('V20', quantity, value, 0.0, 0.0, 0.0, True, unit, 'report')
-
-
 def rise_row(quantity: str, energies: Sequence[float]) -> Row:
     """
     Return the row 'rises monotonically': passes when every energy exceeds the one before.
@@ -349,7 +344,7 @@ def spectrum_rows(record: PileRecord, response: PileResponse) -> list[Row]:
     v = record.speed_kmh
     return [Row('V20', f'car-line window energy vs moving load, {v:g} km/h', e_run, e_g,
                 error, SPECTRUM_TOLERANCE_DB, error <= SPECTRUM_TOLERANCE_DB, 'm2/s3', 'dB'),
-            report_row(f'window energy / quasi-static H R, {v:g} km/h (dB)',
+            report_row('V20', f'window energy / quasi-static H R, {v:g} km/h (dB)',
                        energy_db(e_run, e_hr), 'dB')]
 
 
@@ -358,17 +353,17 @@ def peak_row(record: PileRecord) -> Row:
     peak = pile_peak(record.acceleration, record.rate,
                      harmonic_window(record.scenario, record.duration))
     lo, hi = axle_group_band(record.scenario)
-    return report_row(f'PSD peak {record.speed_kmh:g} km/h (Eq.19 {lo:.2f}-{hi:.2f} Hz)', peak,
-                      'Hz')
+    return report_row('V20', f'PSD peak {record.speed_kmh:g} km/h (Eq.19 {lo:.2f}-{hi:.2f} Hz)',
+                      peak, 'Hz')
 
 
 def energy_rows(records: Sequence[PileRecord]) -> list[Row]:
     """Return the band energies per speed (information) and the two 'rises' rows."""
     eq19 = [eq19_energy(r) for r in records]
     mid = [mid_band_energy(r) for r in records]
-    rows = [report_row(f'Eq.19-band energy, {r.speed_kmh:g} km/h', e, 'm2/s3')
+    rows = [report_row('V20', f'Eq.19-band energy, {r.speed_kmh:g} km/h', e, 'm2/s3')
             for r, e in zip(records, eq19)]
-    rows += [report_row(f'4-10 Hz 1/3-oct. energy, {r.speed_kmh:g} km/h', e, 'm2/s3')
+    rows += [report_row('V20', f'4-10 Hz 1/3-oct. energy, {r.speed_kmh:g} km/h', e, 'm2/s3')
              for r, e in zip(records, mid)]
     span = f'{records[0].speed_kmh:g}-{records[-1].speed_kmh:g}'
     return [*rows, rise_row(f'Eq.19-band energy rises {span}', eq19),

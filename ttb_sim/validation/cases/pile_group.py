@@ -56,7 +56,7 @@ from ttb_sim.sim import SubstructureRun
 from ttb_sim.validation.cases.pile_soil import split_response
 from ttb_sim.validation.references.independent_fe import IndependentBlock
 from ttb_sim.validation.references.pile_soil import shear_column_frequencies
-from ttb_sim.validation.rows import Case, relative_row, Row
+from ttb_sim.validation.rows import Case, relative_row, report_row, Row
 
 LOG = logging.getLogger(__name__)
 
@@ -180,17 +180,11 @@ def amplitude_rows(overrides: Sequence[str] = (),
             relative_row('V15', f'ground amplitude ({f:g} Hz)', run.ground, ground,
                          AMPLITUDE_TOLERANCE, 'm')]
     if shipped is not None:
-        rows += [report_row(f'pile {n} amplitude, Desai interface ({f:g} Hz)', shipped.pile,
-                            run.pile, 'm'),
-                 report_row(f'ground amplitude, Desai interface ({f:g} Hz)', shipped.ground,
-                            run.ground, 'm')]
+        rows += [report_row('V15', f'pile {n} amplitude, Desai interface ({f:g} Hz)',
+                            shipped.pile, 'm', run.pile),
+                 report_row('V15', f'ground amplitude, Desai interface ({f:g} Hz)',
+                            shipped.ground, 'm', run.ground)]
     return rows
-
-
-def report_row(quantity: str, computed: float, reference: float, unit: str) -> Row:
-    """Return an information row: the value and its relative difference from ``reference``."""
-    error = abs(computed - reference) / abs(reference) if reference else math.inf
-    return Row('V15', quantity, computed, reference, error, 0.0, True, unit, 'report')
 
 
 def stratum_frequencies(layers: Sequence[SoilLayer], n: int = 2) -> dict[str, np.ndarray]:
@@ -236,12 +230,11 @@ def transient_rows(layers: Sequence[SoilLayer], runs: Mapping[str, HarmonicRecor
     the block's higher modes.
     """
     closed = stratum_frequencies(layers)
-    rows = [report_row(f'stratum shear mode {k + 1} (closed form)', float(f), float(f), 'Hz')
-            for k, f in enumerate(closed['shear'])]
-    rows += [report_row(f'stratum vertical mode {k + 1} (closed form)', float(f), float(f),
-                        'Hz') for k, f in enumerate(closed['vertical'])]
-    rows.append(report_row("[P]'s transient: V12's 2nd shear mode", float(closed['shear'][1]),
-                           PAPER_TRANSIENT_HZ, 'Hz'))
+    rows = [report_row('V15', f'stratum {kind} mode {k + 1} (closed form)', float(f), 'Hz',
+                       float(f))
+            for kind in ('shear', 'vertical') for k, f in enumerate(closed[kind])]
+    rows.append(report_row('V15', "[P]'s transient: V12's 2nd shear mode",
+                           float(closed['shear'][1]), 'Hz', PAPER_TRANSIENT_HZ))
     first = float(closed['vertical'][0])
     for boundary, run in runs.items():
         label = f'pile transient, {boundary}'
@@ -249,9 +242,9 @@ def transient_rows(layers: Sequence[SoilLayer], runs: Mapping[str, HarmonicRecor
             rows.append(relative_row('V15', label, run.pile_transient_hz, first,
                                      TRANSIENT_TOLERANCE, 'Hz'))
         else:
-            rows.append(report_row(label, run.pile_transient_hz, first, 'Hz'))
-        rows.append(report_row(f'ground transient, {boundary}', run.ground_transient_hz,
-                               first, 'Hz'))
+            rows.append(report_row('V15', label, run.pile_transient_hz, 'Hz', first))
+        rows.append(report_row('V15', f'ground transient, {boundary}', run.ground_transient_hz,
+                               'Hz', first))
     return rows
 
 
