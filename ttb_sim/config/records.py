@@ -50,6 +50,8 @@ from ttb_sim.model.foundation.soil_mesh import planned_nodes
 from ttb_sim.model.track import track_extent, TrackExtent, TrackParameters
 from ttb_sim.model.vehicle.car import CarParameters
 from ttb_sim.model.wheel_rail.contact_parameters import ContactParameters
+from ttb_sim.sensors.places import check_places
+from ttb_sim.sensors.records import decimation_factor, SensorConfig, SensorError
 
 
 @dataclass(frozen=True)
@@ -215,6 +217,11 @@ class Scenario:
     load: PileLoad = field(default_factory=PileLoad)
     solver: SolverConfig = field(default_factory=SolverConfig)
     output: OutputConfig = field(default_factory=OutputConfig)
+    sensors: tuple[SensorConfig, ...] = param(
+        (), '-', 'Virtual sensors, each {name, type, at, axes, rate_hz, noise_density, bias, '
+        'bias_walk, resolution, full_scale, dropout_probability, dropout_mean_length, '
+        'clock_offset, seed, ...}: what a monitoring system records, published on '
+        '~/sensors/<name> (docs/sensors.md).')
 
     def __post_init__(self) -> None:
         """Check the rules that involve more than one key."""
@@ -272,6 +279,7 @@ def car_layout(train: TrainConfig, car: CarParameters) -> tuple[float, ...]:
 
 
 def _check_consistency(s: Scenario) -> None:
+    _check_sensors(s)
     if s.substructure_only:
         _check_substructure(s)
         return
@@ -297,6 +305,22 @@ def _check_consistency(s: Scenario) -> None:
     _check_model_size(s)
     _check_track_fit(s)
     _check_observers(s)
+
+
+def _check_sensors(s: Scenario) -> None:
+    """Refuse repeated sensor names, sensors where their type cannot be, rates off the frames."""
+    seen: set[str] = set()
+    for i, sensor in enumerate(s.sensors):
+        where = f'sensors[{i}]'
+        if sensor.name in seen:
+            raise ScenarioError(f'{where}.name = {sensor.name!r} is used twice')
+        seen.add(sensor.name)
+        try:
+            check_places(sensor)
+            if s.output.rate_hz > 0:
+                decimation_factor(s.output.rate_hz, sensor)
+        except SensorError as exc:
+            raise ScenarioError(f'{where}: {exc}') from None
 
 
 def _check_girder(s: Scenario) -> None:

@@ -214,6 +214,9 @@ class BagRecorder:
         True (default): serialise blocks of frames with learnt layouts; False:
         build and serialise every message with rosbags (the reference path,
         also taken when a topic's layout cannot be learnt).
+    extra : sequence of (str, str)
+        (name, message type) of topics whose messages come one by one, at times of
+        their own (:meth:`write_message`): the virtual sensors and the labels.
 
     Raises
     ------
@@ -223,7 +226,8 @@ class BagRecorder:
     """
 
     def __init__(self, path: str | Path, topics: Sequence[Topic], storage: str = 'mcap',
-                 namespace: str = NAMESPACE, bulk: bool = True) -> None:
+                 namespace: str = NAMESPACE, bulk: bool = True,
+                 extra: Sequence[tuple[str, str]] = ()) -> None:
         check_destination(path, storage)
         self.path = Path(path)
         self._store = typestore()
@@ -234,6 +238,8 @@ class BagRecorder:
         writer = BlockWriter if bulk else Writer
         self._writer = writer(self.path, version=9, storage_plugin=STORAGES[storage])
         self._connections: list[Any] = []
+        self._extra = list(extra)
+        self._extra_connections: list[Any] = []
         self._namespace = namespace
         self.messages = 0
         self._open = False
@@ -254,6 +260,11 @@ class BagRecorder:
             self._writer.add_connection(t.full_name(self._namespace), t.msgtype,
                                         typestore=self._store)
             for t in self._topics]
+        self._extra_connections = [
+            self._writer.add_connection(name if name.startswith('/')
+                                        else f'{self._namespace}/{name}', msgtype,
+                                        typestore=self._store)
+            for name, msgtype in self._extra]
         if self._bulk:
             self._encoder = self._block_encoder()
         return self
@@ -284,6 +295,22 @@ class BagRecorder:
         else:
             self._keep(frame)
         self.messages += len(self._topics)
+
+    def write_message(self, index: int, stamp_ns: int, message: Any) -> None:
+        """Write one message of the ``index``-th extra topic, stamped ``stamp_ns``."""
+        name, msgtype = self._extra[index]
+        self._writer.write(self._extra_connections[index], int(stamp_ns),
+                           self._store.serialize_cdr(message, msgtype))
+        self.messages += 1
+
+    @property
+    def types(self) -> Any:
+        """Return the map from a type name to its message class (rosbags' typestore)."""
+        return self._types
+
+    def set_custom_data(self, key: str, value: str) -> None:
+        """Store ``key: value`` in the bag's metadata (rosbag2's ``custom_data``)."""
+        self._writer.set_custom_data(key, value)
 
     def _keep(self, frame: Frame) -> None:
         row = frame.row

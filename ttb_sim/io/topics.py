@@ -55,26 +55,28 @@ def _time(types: MessageTypes, stamp_ns: int) -> Any:
                                                 nanosec=int(stamp_ns % 1_000_000_000))
 
 
-def _header(types: MessageTypes, stamp_ns: int) -> Any:
+def stamped_header(types: MessageTypes, stamp_ns: int) -> Any:
+    """Build the ``std_msgs/msg/Header`` of a message: its stamp, frame :data:`FRAME_ID`."""
     return types('std_msgs/msg/Header')(stamp=_time(types, stamp_ns), frame_id=FRAME_ID)
 
 
-def _vector3(types: MessageTypes, xyz: Sequence[float] | np.ndarray) -> Any:
+def vector3(types: MessageTypes, xyz: Sequence[float] | np.ndarray) -> Any:
+    """Build a ``geometry_msgs/msg/Vector3`` from (x, y, z)."""
     return types('geometry_msgs/msg/Vector3')(x=float(xyz[0]), y=float(xyz[1]),
                                               z=float(xyz[2]))
 
 
 def build_vector3_stamped(types: MessageTypes, stamp_ns: int, values: np.ndarray) -> Any:
     """Build ``geometry_msgs/msg/Vector3Stamped`` from (x, y, z)."""
-    return types('geometry_msgs/msg/Vector3Stamped')(header=_header(types, stamp_ns),
-                                                     vector=_vector3(types, values))
+    return types('geometry_msgs/msg/Vector3Stamped')(header=stamped_header(types, stamp_ns),
+                                                     vector=vector3(types, values))
 
 
 def build_wrench_stamped(types: MessageTypes, stamp_ns: int, values: np.ndarray) -> Any:
     """Build ``geometry_msgs/msg/WrenchStamped`` from (fx, fy, fz, tx, ty, tz)."""
-    wrench = types('geometry_msgs/msg/Wrench')(force=_vector3(types, values[:3]),
-                                               torque=_vector3(types, values[3:6]))
-    return types('geometry_msgs/msg/WrenchStamped')(header=_header(types, stamp_ns),
+    wrench = types('geometry_msgs/msg/Wrench')(force=vector3(types, values[:3]),
+                                               torque=vector3(types, values[3:6]))
+    return types('geometry_msgs/msg/WrenchStamped')(header=stamped_header(types, stamp_ns),
                                                     wrench=wrench)
 
 
@@ -82,11 +84,11 @@ def build_imu(types: MessageTypes, stamp_ns: int, values: np.ndarray) -> Any:
     """Build ``sensor_msgs/msg/Imu`` from (ax, ay, az, wx, wy, wz); no orientation."""
     quaternion = types('geometry_msgs/msg/Quaternion')(x=0.0, y=0.0, z=0.0, w=1.0)
     return types('sensor_msgs/msg/Imu')(
-        header=_header(types, stamp_ns), orientation=quaternion,
+        header=stamped_header(types, stamp_ns), orientation=quaternion,
         orientation_covariance=_NO_ORIENTATION.copy(),
-        angular_velocity=_vector3(types, values[3:6]),
+        angular_velocity=vector3(types, values[3:6]),
         angular_velocity_covariance=_ZERO9.copy(),
-        linear_acceleration=_vector3(types, values[:3]),
+        linear_acceleration=vector3(types, values[:3]),
         linear_acceleration_covariance=_ZERO9.copy())
 
 
@@ -96,13 +98,13 @@ def build_odometry(types: MessageTypes, stamp_ns: int, values: np.ndarray) -> An
     quaternion = types('geometry_msgs/msg/Quaternion')(x=0.0, y=0.0, z=0.0, w=1.0)
     pose = types('geometry_msgs/msg/Pose')(position=point, orientation=quaternion)
     twist = types('geometry_msgs/msg/Twist')(
-        linear=_vector3(types, (values[1], 0.0, 0.0)),
-        angular=_vector3(types, (0.0, 0.0, 0.0)))
+        linear=vector3(types, (values[1], 0.0, 0.0)),
+        angular=vector3(types, (0.0, 0.0, 0.0)))
     pose_cov = types('geometry_msgs/msg/PoseWithCovariance')(pose=pose,
                                                              covariance=np.zeros(36))
     twist_cov = types('geometry_msgs/msg/TwistWithCovariance')(twist=twist,
                                                                covariance=np.zeros(36))
-    return types('nav_msgs/msg/Odometry')(header=_header(types, stamp_ns),
+    return types('nav_msgs/msg/Odometry')(header=stamped_header(types, stamp_ns),
                                           child_frame_id='train', pose=pose_cov,
                                           twist=twist_cov)
 
@@ -134,7 +136,7 @@ def build_point_cloud(types: MessageTypes, stamp_ns: int, values: np.ndarray) ->
     raw = points.view(np.uint8).ravel()
     # rosbags' message classes take a numpy uint8 array, rclpy's an array('B').
     data: Any = raw if cloud.__module__.startswith('rosbags') else array.array('B', raw.tobytes())
-    return cloud(header=_header(types, stamp_ns), height=1, width=int(points.shape[0]),
+    return cloud(header=stamped_header(types, stamp_ns), height=1, width=int(points.shape[0]),
                  fields=fields, is_bigendian=False, point_step=step,
                  row_step=step * int(points.shape[0]), data=data, is_dense=True)
 

@@ -24,17 +24,21 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 import logging
+from typing import Sequence
 
 import numpy as np
 
 from ttb_sim.config import car_layout, Scenario
 from ttb_sim.errors import ScenarioError
+from ttb_sim.fe.beam import field_rows, point_rows
 from ttb_sim.inputs import shown
+from ttb_sim.model.beam_line import BeamLine
 from ttb_sim.model.bridge import pier_section, rayleigh_coefficients, span_frequency
 from ttb_sim.model.foundation.operator import FoundationOperator
 from ttb_sim.model.irregularity import load_csv, synthesize, TrackIrregularity
 from ttb_sim.model.structure import assemble_structure, Structure
 from ttb_sim.model.vehicle.train import Axles, MovingForces, MultibodyCars, QuarterCars, Vehicle
+from ttb_sim.sensors.places import ProbeRequest
 from ttb_sim.sim.coupling import (Coupling, MovingForceCoupling, QuarterCarTrain,
                                   ReducedTrainTrackCoupling, TrainTrackCoupling)
 from ttb_sim.sim.integrators import Integrator
@@ -42,7 +46,8 @@ from ttb_sim.sim.integrators import Integrator
 LOG = logging.getLogger(__name__)
 
 __all__ = ['build_coupling', 'build_irregularity', 'build_structure', 'build_vehicle',
-           'CONTACT_STEP', 'observer_rows', 'StepLimits', 'vehicle_track_setup',
+           'CONTACT_STEP', 'observer_rows', 'probe_rows', 'ProbeRows', 'StepLimits',
+           'vehicle_track_setup',
            'PROFILE_MARGIN', 'train_length']
 
 
@@ -214,28 +219,85 @@ def observer_rows(scenario: Scenario, structure: Structure) -> tuple[np.ndarray,
     observers = scenario.output.points
     dofs = np.zeros((len(observers), 12), dtype=int)
     rows = np.zeros((len(observers), 3, 12))
-    ftf = structure.full_to_free
-    track = structure.track
     for i, obs in enumerate(observers):
         where = f'output.observers[{i}] = {shown(scenario.output.observers[i])}'
-        if obs.component == 'girder':
-            line = structure.girder_beam
-        elif track is None:
-            raise ScenarioError(f'{where}: component {obs.component!r} needs '
-                                "track.model = 'slab'")
-        else:
-            line = {'rail_left': track.rails[0], 'rail_right': track.rails[1],
-                    'slab': track.slab, 'base': track.base}[obs.component]
-        element, r3, inside = line.rows(np.array([obs.x]), np.zeros(3))
-        if not inside[0]:
-            raise ScenarioError(f'{where}: x is not on the {obs.component}, which runs from '
-                                f'{line.start[0]:g} to {line.end:g} m (slab and base units '
-                                'have gaps)')
-        full = line.dofs[element[0]]
-        r = r3[0]
-        dofs[i] = ftf[full]
-        rows[i] = r
+        line, element, xi = _line_point(structure, obs.component, obs.x, where)
+        dofs[i] = structure.full_to_free[line.dofs[element]]
+        rows[i] = point_rows(xi, line.length[element], np.zeros(3))[0]
     return dofs, rows
+
+
+PROBE_STATES = {'displacement': 0, 'rotation': 0, 'strain': 0, 'velocity': 1,
+                'acceleration': 2}
+"""Which state a probe's rows apply to: 0 displacement, 1 velocity, 2 acceleration."""
+
+
+@dataclass(frozen=True)
+class ProbeRows:
+    """The beam-line probes of the sensors as rows on the extended structure state."""
+
+    dofs: np.ndarray
+    """(n, 12) extended free DOFs of each probe's element."""
+    rows: np.ndarray
+    """(n, 3, 12) rows of the probe's three values."""
+    states: np.ndarray
+    """(n,) the state each probe reads (:data:`PROBE_STATES`)."""
+
+    def values(self, states: np.ndarray) -> np.ndarray:
+        """Return the probes' (n, 3) values from the stacked (3, n_extended) state."""
+        return np.einsum('pij,pj->pi', self.rows, states[self.states[:, None], self.dofs])
+
+
+def probe_rows(requests: Sequence[ProbeRequest], structure: Structure) -> ProbeRows:
+    """
+    Return the rows of the sensors' beam-line probes.
+
+    Displacement, velocity and acceleration: the motion of the beam axis;
+    rotation: (theta_x, theta_y, theta_z); strain: the fibre strain
+    u' - z w'' - y v'' at the fibre (y, z), then two zeros.
+
+    Raises
+    ------
+    ScenarioError
+        For a probe on a track component without a track, or outside the component.
+
+    """
+    n = len(requests)
+    dofs = np.zeros((n, 12), dtype=int)
+    rows = np.zeros((n, 3, 12))
+    for i, req in enumerate(requests):
+        where = f'sensor at {req.component}@{req.x:g}'
+        line, element, xi = _line_point(structure, req.component, req.x, where)
+        dofs[i] = structure.full_to_free[line.dofs[element]]
+        length = line.length[element]
+        if req.quantity == 'rotation':
+            rows[i] = field_rows(xi, length)[0, 3:6]
+        elif req.quantity == 'strain':
+            arm = np.array([0.0, req.fibre[0], req.fibre[1]])
+            rows[i, 0] = point_rows(xi, length, arm, derivative=1)[0, 0]
+        else:
+            rows[i] = point_rows(xi, length, np.zeros(3))[0]
+    states = np.array([PROBE_STATES[r.quantity] for r in requests], dtype=int)
+    return ProbeRows(dofs, rows, states)
+
+
+def _line_point(structure: Structure, component: str, x: float,
+                where: str) -> tuple[BeamLine, np.ndarray, np.ndarray]:
+    """Return (line, element (1,), xi (1,)) of a point of a beam line at track position x."""
+    track = structure.track
+    if component == 'girder':
+        line = structure.girder_beam
+    elif track is None:
+        raise ScenarioError(f"{where}: component {component!r} needs track.model = 'slab'")
+    else:
+        line = {'rail_left': track.rails[0], 'rail_right': track.rails[1],
+                'slab': track.slab, 'base': track.base}[component]
+    element, xi, inside = line.locate(np.array([x]))
+    if not inside[0]:
+        raise ScenarioError(f'{where}: x is not on the {component}, which runs from '
+                            f'{line.start[0]:g} to {line.end:g} m (slab and base units '
+                            'have gaps)')
+    return line, element, xi
 
 
 PROFILE_MARGIN = 50.0

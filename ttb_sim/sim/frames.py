@@ -31,7 +31,7 @@ import numpy as np
 
 ROW_FIELDS = ('head_position', 'speed', 'midspan', 'bearings', 'body_acceleration',
               'body_angular_velocity', 'wheel_rail', 'observers', 'pile_displacement',
-              'pile_acceleration', 'pile_rotation_rate', 'soil_points', 'pier_tops')
+              'pile_acceleration', 'pile_rotation_rate', 'soil_points', 'pier_tops', 'probes')
 """The fields of a :class:`Frame` in the order of :attr:`Frame.row` (after its leading zero)."""
 SOIL_VALUES = 12
 """Values per ground point: x, y, z, displacement, acceleration (the contract's nine), velocity."""
@@ -62,6 +62,8 @@ class Layout:
     soil_point_names: tuple[str, ...] = ()
     """Name of each ground point in frame order, ``pierNN/<name>`` (``line_01``, ``val_1``,
     ``user_01``, ``grid_RR_CC``): written to ``summary.json`` so analysis can tell them apart."""
+    probes: int = 0
+    """Number of beam-line probes the sensors read (:func:`ttb_sim.sensors.probe_requests`)."""
 
     @property
     def n_piles(self) -> int:
@@ -78,7 +80,7 @@ class Layout:
                 'observers': (len(self.observers), 3), 'pile_displacement': piles,
                 'pile_acceleration': piles, 'pile_rotation_rate': piles,
                 'soil_points': (self.soil_points, SOIL_VALUES),
-                'pier_tops': (len(self.piers), 3)}
+                'pier_tops': (len(self.piers), 3), 'probes': (self.probes, 3)}
 
     @property
     def row_width(self) -> int:
@@ -146,6 +148,8 @@ class Frame:
         acceleration (m/s^2), velocity (m/s)
     pier_tops : (n_piers, 3) displacement of each pier top, the bearing seat (m), piers
         in :attr:`Layout.piers` order
+    probes : (n_probes, 3) the beam-line quantities the sensors read, in
+        :func:`~ttb_sim.sensors.probe_requests` order (SI units)
 
     """
 
@@ -164,6 +168,7 @@ class Frame:
     pile_rotation_rate: np.ndarray = field(default_factory=lambda: np.zeros((0, 3)))
     soil_points: np.ndarray = field(default_factory=lambda: np.zeros((0, SOIL_VALUES)))
     pier_tops: np.ndarray = field(default_factory=lambda: np.zeros((0, 3)))
+    probes: np.ndarray = field(default_factory=lambda: np.zeros((0, 3)))
 
     @cached_property
     def row(self) -> np.ndarray:
@@ -177,7 +182,7 @@ class Frame:
             ((0.0, self.head_position, self.speed), self.midspan, self.bearings,
              self.body_acceleration, self.body_angular_velocity, self.wheel_rail,
              self.observers, self.pile_displacement, self.pile_acceleration,
-             self.pile_rotation_rate, self.soil_points, self.pier_tops), axis=None,
+             self.pile_rotation_rate, self.soil_points, self.pier_tops, self.probes), axis=None,
             dtype=np.float64)
 
     @property

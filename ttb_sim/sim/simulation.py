@@ -33,8 +33,9 @@ from ttb_sim.fe.compiled import parallel_threads, pending
 from ttb_sim.model.bearings import bearing_forces
 from ttb_sim.model.constants import GRAVITY
 from ttb_sim.model.vehicle.train import MultibodyCars
+from ttb_sim.sensors.places import probe_requests
 from ttb_sim.sim.build import (build_coupling, build_structure, build_vehicle, observer_rows,
-                               vehicle_track_setup)
+                               probe_rows, vehicle_track_setup)
 from ttb_sim.sim.cost import CostEstimate, estimate_cost, STEP_BUDGET
 from ttb_sim.sim.coupling import FusedCoupling
 from ttb_sim.sim.frames import Frame, Layout
@@ -115,6 +116,7 @@ class Simulation:
         self._speed = scenario.train.speed
         st = self.structure
         self.observers = observer_rows(scenario, st)
+        self.probes = probe_rows(probe_requests(scenario.sensors), st)
         limits, self.irregularity = vehicle_track_setup(scenario, st, self.vehicle)
         element, vf, max_step = limits.element_length, limits.vehicle_frequency, limits.max_step
         spacing = self.irregularity.dx if self.irregularity is not None else None
@@ -159,7 +161,8 @@ class Simulation:
                              piers=tuple(k + 1 for k in st.pier_supports),
                              soil_point_names=tuple(f'pier{p.support + 1:02d}/{name}'
                                                     for p in st.piled
-                                                    for name in p.operator.soil_point_names))
+                                                    for name in p.operator.soil_point_names),
+                             probes=len(self.probes.states))
         self._no_load = np.zeros(0)
         self._state = np.zeros((3, 0))
         self.compiled_loop = False
@@ -379,4 +382,4 @@ class Simulation:
                      body_acceleration=vehicle.body_acceleration,
                      body_angular_velocity=vehicle.body_angular_velocity,
                      wheel_rail=vehicle.wheel_rail, observers=self._observe(ue),
-                     pier_tops=pier_tops, **piles)
+                     pier_tops=pier_tops, probes=self.probes.values(self._state), **piles)

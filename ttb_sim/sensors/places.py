@@ -1,0 +1,158 @@
+# Copyright 2026 The ttb_sim Authors
+#
+# Licensed under the Apache License, Version 2.0 (the "License");
+# you may not use this file except in compliance with the License.
+# You may obtain a copy of the License at
+#
+#     http://www.apache.org/licenses/LICENSE-2.0
+#
+# Unless required by applicable law or agreed to in writing, software
+# distributed under the License is distributed on an "AS IS" BASIS,
+# WITHOUT WARRANTIES OR CONDITIONS OF ANY KIND, either express or implied.
+# See the License for the specific language governing permissions and
+# limitations under the License.
+
+"""
+The places a sensor may be, parsed: locations of ``at`` and ``relative_to``, and the probes.
+
+Sensors on a pile head, a pier top, a car body, a wheel or a ground point read
+values every frame holds already. Sensors on a beam line (girder, rails, slab,
+base plates) read *probes*: rows of the line's element interpolation applied to
+the structure's displacement, velocity or acceleration, or to its derivative
+along the beam (rotation; fibre strain u' - z w'' - y v'' at the fibre (y, z)),
+which the stepping core evaluates at every frame (:func:`probe_requests` gives
+them in frame order). Nothing here needs the model.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+import math
+from typing import Sequence
+
+from ttb_sim.sensors.records import LOCATION_FORMS, SensorConfig, SensorError
+
+__all__ = ['ALLOWED_PLACES', 'check_places', 'Location', 'parse_location', 'probe_requests',
+           'ProbeRequest']
+
+AXIS = {'x': 0, 'y': 1, 'z': 2}
+
+ALLOWED_PLACES = {
+    'accelerometer': {'line': 'acceleration', 'car': 'body_acceleration',
+                      'pile': 'pile_acceleration', 'ground': 'acceleration'},
+    'displacement': {'line': 'displacement', 'pile': 'pile_displacement',
+                     'pier_top': 'pier_tops', 'ground': 'displacement'},
+    'inclinometer': {'line': 'rotation'},
+    'geophone': {'line': 'velocity', 'ground': 'velocity'},
+    'strain': {'line': 'strain'},
+    'wheel_force': {'wheel': 'wheel_rail'},
+}
+"""Per sensor type: the kinds of location it may be at, and what it reads there."""
+
+GROUND_SLOTS = {'displacement': 3, 'acceleration': 6, 'velocity': 9}
+"""First of the three columns of each quantity among a ground point's values."""
+
+
+@dataclass(frozen=True)
+class Location:
+    """A parsed ``at`` (or ``relative_to``): its kind and the numbers or names it holds."""
+
+    kind: str
+    parts: tuple[str, ...]
+
+    @property
+    def x(self) -> float:
+        """Track position of a beam-line point (m)."""
+        return float(self.parts[1])
+
+
+@dataclass(frozen=True)
+class ProbeRequest:
+    """A beam-line quantity the stepping core evaluates at every frame (three values)."""
+
+    component: str
+    """'girder', 'rail_left', 'rail_right', 'slab' or 'base'."""
+    x: float
+    """Track position (m)."""
+    quantity: str
+    """'displacement', 'velocity', 'acceleration' (x, y, z), 'rotation' (about x, y, z) or
+    'strain' (the fibre strain, then two zeros)."""
+    fibre: tuple[float, float] = (0.0, 0.0)
+    """The (y, z) offset of the point from the beam axis (m): the strain gauge's fibre."""
+
+
+def parse_location(text: str, what: str) -> Location:
+    """
+    Parse a location string (``girder@208``, ``car03``, ``pier07/pile05`` ...).
+
+    Raises
+    ------
+    SensorError
+        Naming ``what`` and the forms allowed.
+
+    """
+    for kind, form in LOCATION_FORMS.items():
+        match = form.match(text.strip())
+        if match:
+            location = Location(kind, match.groups())
+            if kind == 'line':
+                try:
+                    x = float(location.parts[1])
+                except ValueError:
+                    x = math.nan
+                if not math.isfinite(x):
+                    raise SensorError(f'{what} = {text!r}: position {location.parts[1]!r} is '
+                                      'not a finite number (m)')
+            return location
+    raise SensorError(f"{what} = {text!r}: allowed forms are 'girder@x' (or rail_left, "
+                      "rail_right, slab, base), 'carNN', 'carNN/axleK/left|right', "
+                      "'pierNN/pileMM', 'pierNN/top', 'ground/pierNN/<point>'")
+
+
+def check_places(config: SensorConfig) -> None:
+    """
+    Check that a sensor's type may be at its location(s) (scenario load time).
+
+    Raises
+    ------
+    SensorError
+        Naming the sensor, its type and where such a sensor may be.
+
+    """
+    places = ALLOWED_PLACES[config.type]
+    for key in ('at', 'relative_to'):
+        text = getattr(config, key)
+        if not text:
+            continue
+        location = parse_location(text, f'{config.name}: {key}')
+        if location.kind not in places:
+            raise SensorError(f'{config.name}: a {config.type} cannot be at {text!r} (a '
+                              f'{location.kind.replace("_", " ")}); allowed: '
+                              f'{", ".join(_FORM_NAMES[k] for k in places)}')
+
+
+_FORM_NAMES = {'line': 'girder@x (rail_left, rail_right, slab, base)', 'car': 'carNN',
+               'wheel': 'carNN/axleK/left|right', 'pile': 'pierNN/pileMM',
+               'pier_top': 'pierNN/top', 'ground': 'ground/pierNN/<point>'}
+
+
+def request_of(config: SensorConfig, text: str) -> ProbeRequest | None:
+    """Return the probe a sensor reads at location ``text`` (None off the beam lines)."""
+    location = parse_location(text, config.name)
+    if location.kind != 'line':
+        return None
+    fibre = (float(config.fibre[0]), float(config.fibre[1])) if config.type == 'strain' \
+        else (0.0, 0.0)
+    return ProbeRequest(location.parts[0], location.x, ALLOWED_PLACES[config.type]['line'],
+                        fibre)
+
+
+def probe_requests(sensors: Sequence[SensorConfig]) -> tuple[ProbeRequest, ...]:
+    """Return the distinct beam-line probes the sensors read, in first-use order."""
+    out: list[ProbeRequest] = []
+    for config in sensors:
+        for text in (config.at, config.relative_to):
+            request = request_of(config, text) if text else None
+            if request is not None and request not in out:
+                out.append(request)
+    return tuple(out)
