@@ -173,10 +173,10 @@ class _Sensing:
     @classmethod
     def of(cls, scenario: Scenario, sim: Runner) -> _Sensing:
         """Return the sensing of a built run (no bank without sensors)."""
-        if not scenario.sensors:
+        if not scenario.all_sensors:
             return cls(scenario, None)
         from ttb_sim.sensors.bank import SensorBank
-        return cls(scenario, SensorBank.of_run(scenario.sensors, sim.layout, sim.dt,
+        return cls(scenario, SensorBank.of_run(scenario.all_sensors, sim.layout, sim.dt,
                                                sim.output_every))
 
     def start(self, bag: BagRecorder) -> None:

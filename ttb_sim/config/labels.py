@@ -70,5 +70,5 @@ def run_labels(scenario: Scenario, speed_kmh: float | None = None) -> dict[str, 
         labels['irregularity'] = {k: irr[k] for k in ('spectrum', 'seed', 'scale', 'file')
                                   if k in irr}
     labels['seeds'] = {'irregularity': scenario.irregularity.seed,
-                       'sensors': {s.name: s.rng_seed for s in scenario.sensors}}
+                       'sensors': {s.name: s.rng_seed for s in scenario.all_sensors}}
     return labels

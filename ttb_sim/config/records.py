@@ -50,6 +50,7 @@ from ttb_sim.model.foundation.soil_mesh import planned_nodes
 from ttb_sim.model.track import track_extent, TrackExtent, TrackParameters
 from ttb_sim.model.vehicle.car import CarParameters
 from ttb_sim.model.wheel_rail.contact_parameters import ContactParameters
+from ttb_sim.sensors.layouts import expand_layouts
 from ttb_sim.sensors.places import check_places
 from ttb_sim.sensors.records import decimation_factor, SensorConfig, SensorError
 
@@ -222,6 +223,11 @@ class Scenario:
         'bias_walk, resolution, full_scale, dropout_probability, dropout_mean_length, '
         'clock_offset, seed, ...}: what a monitoring system records, published on '
         '~/sensors/<name> (docs/sensors.md).')
+    sensor_layouts: tuple[str, ...] = param(
+        (), '-', "Built-in sensor layouts, each 'kind:number': 'span:N' (girder N: "
+        'accelerometers and soffit strain gauges at 1/4, 1/2, 3/4, end inclinometers, bearing '
+        "LVDTs), 'pier:N' (piled pier N: pile-head accelerometers, geophones, settlement), "
+        "'wheelset:N' (car N's first axle); added to sensors (docs/sensors.md).")
 
     def __post_init__(self) -> None:
         """Check the rules that involve more than one key."""
@@ -240,6 +246,14 @@ class Scenario:
                                 points=self.output.soil_points,
                                 grid_spacing=self.output.soil_grid_spacing,
                                 grid_margin=self.output.soil_grid_margin))
+
+    @functools.cached_property
+    def all_sensors(self) -> tuple[SensorConfig, ...]:
+        """The sensors of ``sensor_layouts`` (expanded), then those of ``sensors``."""
+        piers = self.foundation.model in ('springs', 'piled') and self.bearings.model == 'elastic'
+        return expand_layouts(self.sensor_layouts, self.bridge.span_length,
+                              self.bridge.n_spans, piers,
+                              (self.piles.rows, self.piles.cols)) + self.sensors
 
     def axle_positions(self) -> tuple[float, ...]:
         """Distances of all axles behind the head (m): ``train.axle_offsets`` or the car layout."""
@@ -309,9 +323,14 @@ def _check_consistency(s: Scenario) -> None:
 
 def _check_sensors(s: Scenario) -> None:
     """Refuse repeated sensor names, sensors where their type cannot be, rates off the frames."""
+    try:
+        sensors = s.all_sensors
+    except SensorError as exc:
+        raise ScenarioError(str(exc)) from None
     seen: set[str] = set()
-    for i, sensor in enumerate(s.sensors):
-        where = f'sensors[{i}]'
+    n_layout = len(sensors) - len(s.sensors)
+    for i, sensor in enumerate(sensors):
+        where = f'sensors[{i - n_layout}]' if i >= n_layout else 'sensor_layouts'
         if sensor.name in seen:
             raise ScenarioError(f'{where}.name = {sensor.name!r} is used twice')
         seen.add(sensor.name)

@@ -82,6 +82,9 @@ def _columns(config: SensorConfig, text: str, layout: Layout,
 
 
 def _index(what: str, number: int, count: int, name: str) -> int:
+    if count == 0:
+        raise ScenarioError(f'{what}: the model has no {name}s (moving forces have no car '
+                            'bodies or wheels)')
     if not 1 <= number <= count:
         raise ScenarioError(f'{what}: {name} {number} does not exist; the model has '
                             f'{count} (1 to {count})')

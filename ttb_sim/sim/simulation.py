@@ -116,7 +116,7 @@ class Simulation:
         self._speed = scenario.train.speed
         st = self.structure
         self.observers = observer_rows(scenario, st)
-        self.probes = probe_rows(probe_requests(scenario.sensors), st)
+        self.probes = probe_rows(probe_requests(scenario.all_sensors), st)
         limits, self.irregularity = vehicle_track_setup(scenario, st, self.vehicle)
         element, vf, max_step = limits.element_length, limits.vehicle_frequency, limits.max_step
         spacing = self.irregularity.dx if self.irregularity is not None else None
