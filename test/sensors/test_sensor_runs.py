@@ -13,8 +13,10 @@
 # limitations under the License.
 
 """
-Sensors in ``ttb-sim run``: errors before anything is written, the bag's sensor and label
-topics read back by rosbags and by the independent mcap readers, the truth they sample.
+Sensors in ``ttb-sim run``: refusals, topics, the truth they sample, labels, repeatability.
+
+Errors come before anything is written; the bag's sensor and label topics are read back by
+ttb_sim's reader and by the independent mcap readers.
 """
 
 import json
@@ -24,12 +26,11 @@ from mcap_ros2.reader import read_ros2_messages
 import numpy as np
 import pytest
 from scipy import signal
-import yaml
-
 from ttb_sim.cli import main
 from ttb_sim.config import load_scenario
 from ttb_sim.errors import ScenarioError
 from ttb_sim.io import read_bag
+import yaml
 
 SPAN = {'train': {'vehicle': 'moving_force', 'speed_kmh': 200.0, 'axle_offsets': [0.0, 2.5],
                   'axle_load': 156960.0},
