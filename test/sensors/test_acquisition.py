@@ -20,8 +20,8 @@ import numpy as np
 import pytest
 from scipy import signal
 
+from ttb_sim.config.sensor_records import decimation_factor, SensorConfig, SensorError
 from ttb_sim.sensors.acquisition import Acquisition, design_anti_alias
-from ttb_sim.sensors.records import decimation_factor, SensorConfig, SensorError
 
 FRAME_RATE = 1000.0
 

@@ -94,10 +94,18 @@ def test_repeated_names_and_missing_places_are_refused_before_any_bag(tmp_path, 
         load_scenario(str(scenario_file(tmp_path, two)))
     for sensor, message in (({'name': 'w', 'at': 'girder@99.0'}, 'x is not on the girder'),
                             ({'name': 'p', 'at': 'pier02/pile01'}, 'pier 2 is not piled'),
-                            ({'name': 'c', 'at': 'car03'}, 'car 3 does not exist')):
+                            ({'name': 'c', 'at': 'car03'}, 'the model has no cars')):
         out = tmp_path / f'bag_{sensor["name"]}'
         assert main(['run', str(scenario_file(tmp_path, [sensor])), '--out', str(out)]) == 2
         assert message in capsys.readouterr().err and not out.exists()
+
+
+def test_a_car_the_train_does_not_have_is_refused(tmp_path, capsys):
+    out = tmp_path / 'bag'
+    assert main(['run', 'sprung_mass_beam', '--out', str(out), '--set',
+                 'sensors=[{name: c, at: car03}]', '--set', 'output.rate_hz=1000']) == 2
+    assert 'car 3 does not exist; the model has 1 (1 to 1)' in capsys.readouterr().err
+    assert not out.exists()
 
 
 def test_sensor_topics_types_and_rates(sensed_bag):

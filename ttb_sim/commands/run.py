@@ -38,11 +38,8 @@ from ttb_sim.errors import SimulationError
 
 if TYPE_CHECKING:
     from ttb_sim.config import Scenario
-    from ttb_sim.io.bag import BagRecorder
     from ttb_sim.io.topics import PeakTracker, Topic
-    from ttb_sim.sensors.acquisition import Samples
-    from ttb_sim.sensors.bank import SensorBank
-    from ttb_sim.sim import CostEstimate, Frame, Runner
+    from ttb_sim.sim import CostEstimate, Runner
 
 # The model, the stepping core and the bag writer are imported where first needed (about a
 # second): a scenario path that does not exist is refused before them.
@@ -106,7 +103,9 @@ def run_to_bag(scenario: Scenario, out: str | Path, storage: str = 'mcap',
         Re-raised after the bag and summary have been closed and written.
 
     """
+    from ttb_sim.config.labels import LABELS_KEY
     from ttb_sim.io.bag import BagRecorder, check_destination, make_parents
+    from ttb_sim.io.sensor_stream import SensorStream
     from ttb_sim.io.topics import NAMESPACE, PeakTracker, topic_table
     from ttb_sim.sim import make_runner
 
@@ -116,7 +115,7 @@ def run_to_bag(scenario: Scenario, out: str | Path, storage: str = 'mcap',
     sim = simulation or make_runner(scenario)
     setup_time += time.perf_counter() - built
     topics = topic_table(sim.layout)
-    sensing = _Sensing.of(scenario, sim)   # a bad sensor place is refused before the bag
+    sensing = SensorStream(scenario, sim.layout, sim.dt, sim.output_every)  # before the bag
     estimate = estimate or sim.plan(len(topics))
     peaks = PeakTracker(topics)
     make_parents(out)
@@ -124,11 +123,13 @@ def run_to_bag(scenario: Scenario, out: str | Path, storage: str = 'mcap',
     start = time.perf_counter()
     try:
         with BagRecorder(out, topics, storage, extra=sensing.extra) as bag:
-            sensing.start(bag)
+            bag.set_custom_data(LABELS_KEY, json.dumps(sensing.labels, sort_keys=True))
+            bag.write_message(*sensing.labels_message(bag.types))
             try:
                 for frame in sim.frames():
                     bag.write(frame)
-                    sensing.write(bag, frame)
+                    for message in sensing.push(frame, bag.types):
+                        bag.write_message(*message)
                     peaks.update(frame)
                     done.frames += 1
                     done.last_time = frame.time
@@ -138,7 +139,8 @@ def run_to_bag(scenario: Scenario, out: str | Path, storage: str = 'mcap',
                         done.status, done.message = 'interrupted', 'stopped by a signal'
                         break
             finally:   # the samples of the frames written, whatever ended the run
-                sensing.finish(bag)
+                for message in sensing.flush(bag.types):
+                    bag.write_message(*message)
     except SimulationError as exc:  # divergence, interface iterations that fail
         done.status, done.message = 'diverged', str(exc)
     except KeyboardInterrupt:
@@ -154,59 +156,6 @@ def run_to_bag(scenario: Scenario, out: str | Path, storage: str = 'mcap',
             (out / 'summary.json').write_text(json.dumps(summary, indent=2) + '\n',
                                               encoding='utf-8')
     return RunResult(path=out, status=done.status, summary=summary)
-
-
-class _Sensing:
-    """The virtual sensors and the labels of a run, as the bag writer sees them."""
-
-    def __init__(self, scenario: Scenario, bank: SensorBank | None) -> None:
-        from ttb_sim.config.labels import run_labels
-        from ttb_sim.io.sensor_topics import LABELS_TOPIC, sensor_topics
-
-        self.bank = bank
-        self.labels = run_labels(scenario)
-        self.topics = [] if bank is None else sensor_topics(
-            [c.config for c in bank.channels], [c.acquisition.sigma for c in bank.channels])
-        self.extra = [(LABELS_TOPIC, 'std_msgs/msg/String')] + [
-            (t.name, t.msgtype) for t in self.topics]
-
-    @classmethod
-    def of(cls, scenario: Scenario, sim: Runner) -> _Sensing:
-        """Return the sensing of a built run (no bank without sensors)."""
-        if not scenario.all_sensors:
-            return cls(scenario, None)
-        from ttb_sim.sensors.bank import SensorBank
-        return cls(scenario, SensorBank.of_run(scenario.all_sensors, sim.layout, sim.dt,
-                                               sim.output_every))
-
-    def start(self, bag: BagRecorder) -> None:
-        """Write the labels: the bag's metadata and the first message of ``~/labels``."""
-        from ttb_sim.config.labels import LABELS_KEY
-        from ttb_sim.io.sensor_topics import labels_message
-
-        bag.set_custom_data(LABELS_KEY, json.dumps(self.labels, sort_keys=True))
-        bag.write_message(0, 0, labels_message(bag.types, self.labels))
-
-    def write(self, bag: BagRecorder, frame: Frame) -> None:
-        """Give a frame to the sensors; write the samples they return."""
-        if self.bank is not None:
-            self._write(bag, self.bank.push(frame))
-
-    def finish(self, bag: BagRecorder) -> None:
-        """Write the samples of the frames the sensors still keep."""
-        if self.bank is not None:
-            self._write(bag, self.bank.flush())
-
-    def _write(self, bag: BagRecorder, batches: list[tuple[int, Samples]]) -> None:
-        for index, samples in batches:
-            topic = self.topics[index]
-            for stamp, xyz in zip(samples.stamps_ns, topic.spread(samples.values)):
-                bag.write_message(index + 1, int(stamp), topic.message(bag.types, int(stamp),
-                                                                       xyz))
-
-    def describe(self) -> list[dict[str, Any]]:
-        """Return the sensors for ``summary.json`` (none without a bank)."""
-        return [] if self.bank is None else self.bank.describe()
 
 
 @dataclass

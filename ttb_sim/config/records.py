@@ -37,6 +37,9 @@ from typing import Any
 
 from ttb_sim.config.observers import Observer, parse_observers
 from ttb_sim.config.schema import to_plain
+from ttb_sim.config.sensor_layouts import expand_layouts
+from ttb_sim.config.sensor_places import check_places
+from ttb_sim.config.sensor_records import decimation_factor, SensorConfig, SensorError
 from ttb_sim.declarations import param
 from ttb_sim.errors import ScenarioError
 from ttb_sim.inputs import shown
@@ -50,9 +53,6 @@ from ttb_sim.model.foundation.soil_mesh import planned_nodes
 from ttb_sim.model.track import track_extent, TrackExtent, TrackParameters
 from ttb_sim.model.vehicle.car import CarParameters
 from ttb_sim.model.wheel_rail.contact_parameters import ContactParameters
-from ttb_sim.sensors.layouts import expand_layouts
-from ttb_sim.sensors.places import check_places
-from ttb_sim.sensors.records import decimation_factor, SensorConfig, SensorError
 
 
 @dataclass(frozen=True)

@@ -37,12 +37,12 @@ from typing import Any, Sequence
 
 import numpy as np
 
+from ttb_sim.config.sensor_places import AXIS
+from ttb_sim.config.sensor_records import SensorConfig
 from ttb_sim.io.topics import (build_vector3_stamped, build_wrench_stamped, MessageTypes,
                                NAMESPACE, stamped_header, vector3)
-from ttb_sim.sensors.places import AXIS
-from ttb_sim.sensors.records import SensorConfig
 
-__all__ = ['LABELS_TOPIC', 'labels_message', 'SensorTopic', 'sensor_topics']
+__all__ = ['extra_topics', 'LABELS_TOPIC', 'labels_message', 'SensorTopic', 'sensor_topics']
 
 LABELS_TOPIC = 'labels'
 """The labels' topic, private to the node (``~/labels``)."""
@@ -103,6 +103,12 @@ class SensorTopic:
             angular_velocity=vector3(types, (0.0, 0.0, 0.0)),
             angular_velocity_covariance=not_provided.copy(),
             linear_acceleration=vector3(types, xyz), linear_acceleration_covariance=covariance)
+
+
+def extra_topics(sensors: Sequence[SensorConfig]) -> list[tuple[str, str]]:
+    """Return (name, message type) of the labels' topic, then of each sensor's topic."""
+    return [(LABELS_TOPIC, 'std_msgs/msg/String')] + [
+        (SensorTopic(c, 0.0).name, SensorTopic(c, 0.0).msgtype) for c in sensors]
 
 
 def sensor_topics(sensors: Sequence[SensorConfig],

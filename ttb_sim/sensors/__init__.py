@@ -15,15 +15,18 @@
 """
 Virtual sensors: what a monitoring system would record of the model, with its imperfections.
 
-The scenario's ``sensors`` list (:class:`SensorConfig`) names each sensor, its
-type, its place in the model and its acquisition chain; :class:`SensorBank`
-(``ttb_sim.sensors.bank``) turns the frames of a run into each sensor's samples,
-published on ``~/sensors/<name>`` beside the exact truth on the other topics.
-See docs/sensors.md.
+A scenario's ``sensors`` list and ``sensor_layouts`` (records in
+:mod:`ttb_sim.config.sensor_records`, places in :mod:`ttb_sim.config.sensor_places`,
+layouts in :mod:`ttb_sim.config.sensor_layouts`) name each sensor, its type, its
+place in the model and its acquisition chain. Here: :class:`SensorBank` gathers each
+sensor's truth from the frames of a run (:mod:`~ttb_sim.sensors.locations`) and
+passes it through its :class:`Acquisition` chain; ``ttb-sim run`` publishes the
+samples on ``~/sensors/<name>`` beside the exact truth. See docs/sensors.md.
 """
 
-from ttb_sim.sensors.places import ALLOWED_PLACES, probe_requests, ProbeRequest
-from ttb_sim.sensors.records import SENSOR_TYPES, SensorConfig, SensorError, UNITS
+from ttb_sim.config.sensor_records import SENSOR_TYPES, SensorConfig, SensorError, UNITS
+from ttb_sim.sensors.acquisition import Acquisition, AntiAlias, design_anti_alias, Samples
+from ttb_sim.sensors.bank import SensorBank, SensorChannel
 
-__all__ = ['ALLOWED_PLACES', 'probe_requests', 'ProbeRequest', 'SENSOR_TYPES', 'SensorConfig',
-           'SensorError', 'UNITS']
+__all__ = ['Acquisition', 'AntiAlias', 'design_anti_alias', 'Samples', 'SENSOR_TYPES',
+           'SensorBank', 'SensorChannel', 'SensorConfig', 'SensorError', 'UNITS']

@@ -33,7 +33,7 @@ import math
 import numpy as np
 from scipy import signal
 
-from ttb_sim.sensors.records import decimation_factor, SensorConfig
+from ttb_sim.config.sensor_records import decimation_factor, SensorConfig
 
 __all__ = ['Acquisition', 'AntiAlias', 'Samples', 'design_anti_alias']
 

@@ -30,12 +30,12 @@ from typing import Any, Sequence
 
 import numpy as np
 
+from ttb_sim.config.sensor_places import probe_requests
+from ttb_sim.config.sensor_records import SensorConfig, SensorError
 from ttb_sim.errors import ScenarioError
 from ttb_sim.sensors.acquisition import Acquisition, Samples
 from ttb_sim.sensors.locations import truth_columns
-from ttb_sim.sensors.places import probe_requests
-from ttb_sim.sensors.records import SensorConfig, SensorError
-from ttb_sim.sim.frames import Frame, Layout
+from ttb_sim.sim import Frame, Layout
 
 __all__ = ['BLOCK_FRAMES', 'SensorBank', 'SensorChannel']
 

@@ -17,7 +17,7 @@ Where a sensor's truth is: its location turned into columns of the frames' flat 
 
 The columns index :attr:`~ttb_sim.sim.frames.Frame.row`: the frame's own fields for
 sensors on piles, pier tops, cars, wheels and ground points, its ``probes`` for
-sensors on beam lines (:mod:`ttb_sim.sensors.places`).
+sensors on beam lines (:mod:`ttb_sim.config.sensor_places`).
 """
 
 from __future__ import annotations
@@ -26,11 +26,11 @@ from typing import Sequence
 
 import numpy as np
 
+from ttb_sim.config.sensor_places import (ALLOWED_PLACES, AXIS, GROUND_SLOTS, Location,
+                                          parse_location, ProbeRequest, request_of)
+from ttb_sim.config.sensor_records import SensorConfig
 from ttb_sim.errors import ScenarioError
-from ttb_sim.sensors.places import (ALLOWED_PLACES, AXIS, GROUND_SLOTS, Location,
-                                    parse_location, ProbeRequest, request_of)
-from ttb_sim.sensors.records import SensorConfig
-from ttb_sim.sim.frames import Layout, SOIL_VALUES
+from ttb_sim.sim import Layout, SOIL_VALUES
 
 __all__ = ['truth_columns']
 

@@ -24,9 +24,9 @@ The names below are the package's face: the layers above (commands, node,
 validation) take what they need of the stepping core from here.
 """
 
-from ttb_sim.sim.build import build_structure, build_vehicle
+from ttb_sim.sim.build import build_structure, build_vehicle, probe_rows, ProbeRows
 from ttb_sim.sim.cost import CostEstimate, estimate_cost, STEP_BUDGET
-from ttb_sim.sim.frames import Frame, Layout
+from ttb_sim.sim.frames import Frame, Layout, SOIL_VALUES
 from ttb_sim.sim.integrators.newmark import Newmark
 from ttb_sim.sim.runner import make_runner, Runner
 from ttb_sim.sim.simulation import Simulation
@@ -34,6 +34,6 @@ from ttb_sim.sim.substructure import reference_refusal, substructure_dof_counts,
 from ttb_sim.sim.variants import blas_threads, solver_variant, VARIANTS
 
 __all__ = ['blas_threads', 'build_structure', 'build_vehicle', 'CostEstimate', 'estimate_cost',
-           'Frame', 'Layout', 'make_runner', 'Newmark', 'reference_refusal',
-           'Runner', 'Simulation', 'solver_variant', 'STEP_BUDGET', 'substructure_dof_counts',
-           'SubstructureRun', 'VARIANTS']
+           'Frame', 'Layout', 'make_runner', 'Newmark', 'probe_rows', 'ProbeRows',
+           'reference_refusal', 'Runner', 'Simulation', 'SOIL_VALUES', 'solver_variant',
+           'STEP_BUDGET', 'substructure_dof_counts', 'SubstructureRun', 'VARIANTS']

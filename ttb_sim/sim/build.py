@@ -29,6 +29,7 @@ from typing import Sequence
 import numpy as np
 
 from ttb_sim.config import car_layout, Scenario
+from ttb_sim.config.sensor_places import ProbeRequest
 from ttb_sim.errors import ScenarioError
 from ttb_sim.fe.beam import field_rows, point_rows
 from ttb_sim.inputs import shown
@@ -38,7 +39,6 @@ from ttb_sim.model.foundation.operator import FoundationOperator
 from ttb_sim.model.irregularity import load_csv, synthesize, TrackIrregularity
 from ttb_sim.model.structure import assemble_structure, Structure
 from ttb_sim.model.vehicle.train import Axles, MovingForces, MultibodyCars, QuarterCars, Vehicle
-from ttb_sim.sensors.places import ProbeRequest
 from ttb_sim.sim.coupling import (Coupling, MovingForceCoupling, QuarterCarTrain,
                                   ReducedTrainTrackCoupling, TrainTrackCoupling)
 from ttb_sim.sim.integrators import Integrator

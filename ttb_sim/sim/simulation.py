@@ -28,12 +28,12 @@ from typing import Any, Iterator
 import numpy as np
 
 from ttb_sim.config import Scenario
+from ttb_sim.config.sensor_places import probe_requests
 from ttb_sim.errors import DivergenceError, ModelError, ScenarioError
 from ttb_sim.fe.compiled import parallel_threads, pending
 from ttb_sim.model.bearings import bearing_forces
 from ttb_sim.model.constants import GRAVITY
 from ttb_sim.model.vehicle.train import MultibodyCars
-from ttb_sim.sensors.places import probe_requests
 from ttb_sim.sim.build import (build_coupling, build_structure, build_vehicle, observer_rows,
                                probe_rows, vehicle_track_setup)
 from ttb_sim.sim.cost import CostEstimate, estimate_cost, STEP_BUDGET

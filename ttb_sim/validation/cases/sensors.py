@@ -15,30 +15,28 @@
 """
 V24: the virtual sensors — noise, anti-alias filter, decimation, dropouts, strain.
 
-Each row goes through the code users run: a scenario's ``sensors`` through
-``ttb-sim run``'s :func:`~ttb_sim.commands.run.run_to_bag` and back through the bag
-reader (noise), the acquisition chain of :mod:`ttb_sim.sensors.acquisition` (filter,
-decimation, dropouts, bias walk), and the probe rows of the model's own girder
-(strain). The references are independent of the chain: the noise density the
-sensor is given, a tone's attenuation required by the issue (60 dB), the filter's
-frequency response evaluated in the frequency domain, the dropout fraction asked
-for, and M c / EI of a simply supported span.
+Each row goes through the code users run: a scenario's ``sensors`` through the model
+and the :class:`~ttb_sim.sensors.SensorBank` that ``ttb-sim run`` feeds (noise), the
+acquisition chain of :mod:`ttb_sim.sensors.acquisition` (filter, decimation, dropouts,
+bias walk), and the probe rows of the model's own girder (strain). The references
+are independent of the chain: the noise density the sensor is given, a tone's
+attenuation required by the issue (60 dB), the filter's frequency response evaluated
+in the frequency domain, the dropout fraction asked for, and M c / EI of a simply
+supported span.
 """
 
 from __future__ import annotations
 
 import math
-from pathlib import Path
-import tempfile
 
 import numpy as np
 from scipy import signal
 import scipy.sparse.linalg as spla
 
 from ttb_sim.config import load_scenario
+from ttb_sim.config.sensor_places import probe_requests
+from ttb_sim.config.sensor_records import SensorConfig
 from ttb_sim.sensors.acquisition import Acquisition
-from ttb_sim.sensors.places import probe_requests
-from ttb_sim.sensors.records import SensorConfig
 from ttb_sim.validation.rows import Case, relative_row, Row
 
 __all__ = ['SENSOR_CASES']
@@ -70,21 +68,22 @@ QUIET_SCENARIO = {
     'bearings': {'model': 'rigid'}, 'foundation': {'model': 'rigid'},
     'solver': {'duration': 5.0}, 'output': {'rate_hz': FRAME_RATE},
     'sensors': [{'name': 'deck_z', 'type': 'accelerometer', 'at': 'girder@16.0',
-                 'rate_hz': SENSOR_RATE, 'noise_density': NOISE_DENSITY}]}
+                 'axes': 'z', 'rate_hz': SENSOR_RATE, 'noise_density': NOISE_DENSITY}]}
 
 
 def noise_density_row() -> Row:
     """Compare the Welch ASD of a girder accelerometer on a quiet span with its density."""
-    from ttb_sim.commands.run import run_to_bag
-    from ttb_sim.io import read_bag
-    import yaml
+    from ttb_sim.config.schema import from_mapping
+    from ttb_sim.config.records import Scenario
+    from ttb_sim.sensors import SensorBank
+    from ttb_sim.sim import Simulation
 
-    with tempfile.TemporaryDirectory() as tmp:
-        path = Path(tmp) / 'quiet.yaml'
-        path.write_text(yaml.safe_dump(QUIET_SCENARIO), encoding='utf-8')
-        run_to_bag(load_scenario(str(path)), Path(tmp) / 'bag')
-        z = read_bag(Path(tmp) / 'bag')['/ttb_sim/sensors/deck_z'].fields['linear_acceleration']
-    f, psd = signal.welch(z[:, 2], fs=SENSOR_RATE, nperseg=128)
+    scenario = from_mapping(QUIET_SCENARIO, Scenario)
+    sim = Simulation(scenario)
+    bank = SensorBank.of_run(scenario.all_sensors, sim.layout, sim.dt, sim.output_every)
+    batches = [b for frame in sim.frames() for b in bank.push(frame)] + bank.flush()
+    z = np.concatenate([samples.values[:, 0] for _, samples in batches])
+    f, psd = signal.welch(z, fs=SENSOR_RATE, nperseg=128)
     band = (f > 2.0) & (f < 0.9 * SENSOR_RATE / 2)
     asd = math.sqrt(float(np.mean(psd[band])))
     return relative_row('V24', 'noise: ASD of a girder accelerometer on a quiet span (Welch)',
@@ -153,7 +152,7 @@ def dropout_rows() -> list[Row]:
 
 def strain_rows() -> list[Row]:
     """Compare soffit strain gauges of a span under a static mid-span load with M c / EI."""
-    from ttb_sim.sim.build import build_structure, probe_rows
+    from ttb_sim.sim import build_structure, probe_rows
 
     fibre, load = -1.5, 1.0e6
     scenario = load_scenario('moving_force_beam', [], [('sensors', [

@@ -32,7 +32,7 @@ from __future__ import annotations
 
 from typing import Any, Sequence
 
-from ttb_sim.sensors.records import SensorConfig, SensorError
+from ttb_sim.config.sensor_records import SensorConfig, SensorError
 
 __all__ = ['expand_layouts', 'LAYOUT_KINDS', 'SOFFIT_FIBRE']
 

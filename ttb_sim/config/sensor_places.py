@@ -30,7 +30,7 @@ from dataclasses import dataclass
 import math
 from typing import Sequence
 
-from ttb_sim.sensors.records import LOCATION_FORMS, SensorConfig, SensorError
+from ttb_sim.config.sensor_records import LOCATION_FORMS, SensorConfig, SensorError
 
 __all__ = ['ALLOWED_PLACES', 'check_places', 'Location', 'parse_location', 'probe_requests',
            'ProbeRequest']
