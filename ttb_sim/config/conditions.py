@@ -60,7 +60,7 @@ def check_conditions(s: Scenario) -> None:
     """
     damage, env = s.damage, s.environment
     if s.substructure_only:
-        if damage.any or env.changes_soil:
+        if damage.given or env.changes_soil:
             raise ScenarioError(f'load.type = {s.load.type!r} runs the pile-soil substructure '
                                 'alone; damage entries and environment.soil_modulus_scale '
                                 "apply to a bridge run (load.type = 'none', foundation.model "
@@ -79,11 +79,13 @@ def check_conditions(s: Scenario) -> None:
 def _check_piers(s: Scenario) -> None:
     damage, env = s.damage, s.environment
     piled = s.foundation.piled_piers if s.foundation.model == 'piled' else ()
-    for key, entries in (('damage.piles', damage.piles), ('damage.scour', damage.scour)):
-        for i, entry in enumerate(entries):
-            if entry.pier not in piled:
+    named = (('damage.piles', [p.pier for p in damage.piles]),
+             ('damage.scour', [c.pier for c in damage.scour]))
+    for key, piers in named:
+        for i, pier in enumerate(piers):
+            if pier not in piled:
                 raise ScenarioError(
-                    f'{key}[{i}].pier = {entry.pier} is not a piled pier; allowed: '
+                    f'{key}[{i}].pier = {pier} is not a piled pier; allowed: '
                     f'{list(piled) if piled else "none"} (foundation.piled_piers with '
                     "foundation.model = 'piled')")
     if env.changes_soil and not piled:

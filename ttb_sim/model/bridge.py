@@ -202,7 +202,8 @@ def girder_block(b: BridgeParameters, bending_factors: np.ndarray | None = None
     Return the girders (nodes 0.., ``elements_per_span`` elements per span) and their nodes.
 
     ``bending_factors`` (n_spans * elements_per_span,), if given, multiply the vertical
-    bending stiffness of each element (damage, :func:`ttb_sim.model.damage.girder_bending_factors`).
+    bending stiffness of each element (damage,
+    :func:`ttb_sim.model.damage.girder_bending_factors`).
 
     Returns
     -------

@@ -53,8 +53,6 @@ __all__ = ['bearing_stiffness_factors', 'BearingDamage', 'damaged_substructure',
 SCOUR_RESIDUAL = 1e-6
 """Fraction of modulus, density and cohesion left in scoured soil (removed, numerically)."""
 
-_LOSS = dict(low=0.0, high=1.0, high_inclusive=False)
-
 
 class DamageError(ModelError):
     """A damage entry is described by invalid values."""
@@ -71,7 +69,8 @@ class GirderDamage:
                           high=500.0, low_inclusive=False)
     stiffness_loss: float = param(0.0, '-', 'Fraction of the vertical bending stiffness EI '
                                   'lost in the zone (lateral bending, torsion and axial '
-                                  'stiffness are kept).', **_LOSS)
+                                  'stiffness are kept).', low=0.0, high=1.0,
+                                  high_inclusive=False)
 
     def __post_init__(self) -> None:
         """Check every field against its declaration."""
@@ -79,12 +78,12 @@ class GirderDamage:
 
     @property
     def start(self) -> float:
-        """Start of the zone from the span's start (m)."""
+        """Return the distance (m) from the span's first end to the zone's."""
         return self.position - 0.5 * self.length
 
     @property
     def end(self) -> float:
-        """End of the zone from the span's start (m)."""
+        """Return the distance (m) from the span's first end to the zone's far end."""
         return self.position + 0.5 * self.length
 
 
@@ -98,7 +97,8 @@ class BearingDamage:
                       choices=('left', 'right', 'both'))
     stiffness_loss: float = param(0.0, '-', 'Fraction of the vertical, lateral and '
                                   'longitudinal stiffness of the bearings lost (their '
-                                  'damping is kept).', **_LOSS)
+                                  'damping is kept).', low=0.0, high=1.0,
+                                  high_inclusive=False)
 
     def __post_init__(self) -> None:
         """Check every field against its declaration."""
@@ -112,7 +112,8 @@ class PileDamage:
     pier: int = param(2, '-', 'Piled pier, by its support number (as in '
                       'foundation.piled_piers).', low=2, high=50)
     stiffness_loss: float = param(0.0, '-', "Fraction of the Young's modulus of all the "
-                                  "piles of the pier's group lost.", **_LOSS)
+                                  "piles of the pier's group lost.", low=0.0, high=1.0,
+                                  high_inclusive=False)
 
     def __post_init__(self) -> None:
         """Check every field against its declaration."""
@@ -152,8 +153,8 @@ class DamageParameters:
         '(docs/damage.md).')
 
     @property
-    def any(self) -> bool:
-        """True when some damage entry is given (even with a zero loss)."""
+    def given(self) -> bool:
+        """Tell whether some damage entry is given, even one with a zero loss."""
         return bool(self.girder or self.bearings or self.piles or self.scour)
 
 

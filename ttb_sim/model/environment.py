@@ -57,7 +57,7 @@ class EnvironmentParameters:
         'EA, GJ and both EI (default: the frequency slope -0.13 to -0.23 %/degC of Xia et al. '
         '2006 times two; docs/damage.md).', low=-0.1, high=0.1)
     bearing_stiffness_coefficient: float = param(
-        -2.0 / 45.0, '1/degC', 'alpha_b of the bearings\' k(T) = k_ref (1 + alpha_b (T - '
+        -2.0 / 45.0, '1/degC', "alpha_b of the bearings' k(T) = k_ref (1 + alpha_b (T - "
         'T_ref)) below T_ref (no change above; default: the factor 3 at -25 degC that BS '
         '5400-9.1 allows, TRL RR299; docs/damage.md).', low=-1.0, high=0.0)
     soil_modulus_scale: tuple[float, ...] = param(
@@ -109,8 +109,8 @@ def scaled_soil(soil: SoilParameters, env: EnvironmentParameters) -> SoilParamet
     if not scale:
         return soil
     if len(scale) != len(soil.layers):
-        raise EnvironmentValueError(f'environment.soil_modulus_scale = {list(scale)!r} has '
-                               f'{len(scale)} factors for {len(soil.layers)} soil.layers; '
-                               'allowed: one factor per layer, top down')
+        message = (f'environment.soil_modulus_scale = {list(scale)!r} has {len(scale)} factors '
+                   f'for {len(soil.layers)} soil.layers; allowed: one factor per layer, top down')
+        raise EnvironmentValueError(message)
     layers = tuple(replace(layer, E=layer.E * s) for layer, s in zip(soil.layers, scale))
     return replace(soil, layers=layers)

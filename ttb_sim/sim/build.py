@@ -34,8 +34,8 @@ from ttb_sim.errors import ScenarioError
 from ttb_sim.inputs import shown
 from ttb_sim.model.bridge import pier_section, rayleigh_coefficients, span_frequency
 from ttb_sim.model.constants import GRAVITY
-from ttb_sim.model.foundation.records import Substructure
 from ttb_sim.model.foundation.operator import FoundationOperator
+from ttb_sim.model.foundation.records import Substructure
 from ttb_sim.model.irregularity import load_csv, synthesize, TrackIrregularity
 from ttb_sim.model.structure import assemble_structure, Structure
 from ttb_sim.model.vehicle.payload import loaded_car, mass_per_axle

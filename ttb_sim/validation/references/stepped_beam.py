@@ -85,7 +85,7 @@ class SteppedBeam:
         return float(t[0, 1] * t[2, 3] - t[0, 3] * t[2, 1])
 
     def frequencies(self, count: int = 1, points_per_mode: int = 200) -> np.ndarray:
-        """Return the first ``count`` bending frequencies (Hz)."""
+        """Return the lowest ``count`` natural frequencies in Hz."""
         ei_min = min(self.stiffness)
         ei_max = max(self.stiffness)
         scale = math.pi**2 / self.length**2 / math.sqrt(self.mass_per_length)
