@@ -21,8 +21,8 @@ Environment: the scenario section ``environment`` and the stiffness changes it i
   because f ~ sqrt(E).
 - Bearing stiffness: k(T) = k_ref (1 + alpha_b (T - T_ref)) below T_ref, k_ref above
   (elastomers stiffen in the cold and hardly soften in the warm); the default
-  alpha_b = -2 / 45 / degC is the largest stiffening BS 5400-9.1 allows for a bearing
-  elastomer, a factor of 3 after 24 h at -25 degC (TRL RR299), from T_ref = 20 degC.
+  alpha_b = -2 / 45 / degC is the largest low-temperature stiffening TRL RR299 recommends
+  accepting for a bearing elastomer, a factor of 3 after 24 h at -25 degC, from 20 degC.
 - Soil: a factor per soil layer on its Young's modulus (frozen or wet ground).
 
 Sources and limits are in docs/damage.md.
@@ -58,8 +58,8 @@ class EnvironmentParameters:
         '2006 times two; docs/damage.md).', low=-0.1, high=0.1)
     bearing_stiffness_coefficient: float = param(
         -2.0 / 45.0, '1/degC', "alpha_b of the bearings' k(T) = k_ref (1 + alpha_b (T - "
-        'T_ref)) below T_ref (no change above; default: the factor 3 at -25 degC that BS '
-        '5400-9.1 allows, TRL RR299; docs/damage.md).', low=-1.0, high=0.0)
+        'T_ref)) below T_ref (no change above; default: the factor 3 at -25 degC that TRL '
+        'RR299 accepts at most; docs/damage.md).', low=-1.0, high=0.0)
     soil_modulus_scale: tuple[float, ...] = param(
         (), '-', "Factor on the Young's modulus of each soil layer, top down (one per entry "
         'of soil.layers; frozen ground > 1, saturated < 1); empty = 1 everywhere.',
