@@ -90,8 +90,8 @@ def test_loss_over_the_whole_span_scales_f1_by_sqrt_1_minus_loss_to_1e9(loss: fl
     (9.0, 4.0, 0.3, 5e-4),     # two elements half covered: the flexibility average
     (16.0, 1.0, 0.5, 5e-4),    # inside one element
 ])
-def test_f1_of_a_damaged_segment_matches_the_stepped_beam(position: float, length: float,
-                                                         loss: float, tolerance: float) -> None:
+def test_f1_of_a_damaged_segment_matches_the_stepped_beam(
+        position: float, length: float, loss: float, tolerance: float) -> None:
     """First bending frequency against the transfer-matrix stepped beam (V23's reference)."""
     span, ei, mass = _beam()
     zone = (position - length / 2, position + length / 2, loss)
@@ -146,7 +146,7 @@ def test_bearing_loss_gives_the_support_stiffness_2k_1_minus_loss_to_1e9() -> No
 
 @pytest.mark.parametrize('temperature', [-10.0, 35.0])
 def test_temperature_shifts_f1_by_sqrt_of_the_modulus_factor_to_1e9(temperature: float) -> None:
-    """f ~ sqrt(E): f1(T) / f1(T_ref) = sqrt(1 + alpha_E (T - T_ref))."""
+    """Frequency goes with sqrt(E): f1(T) / f1(T_ref) = sqrt(1 + alpha_E (T - T_ref))."""
     s = load_scenario(BEAM, [f'environment.temperature={temperature}'])
     alpha = s.environment.girder_modulus_coefficient
     ratio = math.sqrt(1.0 + alpha * (temperature - 20.0))
