@@ -30,11 +30,15 @@ import scipy.sparse.linalg as spla
 from ttb_sim.config import load_scenario, Scenario
 from ttb_sim.config.conditions import pier_substructure
 from ttb_sim.errors import ScenarioError
+from ttb_sim.model.bridge import pier_section
 from ttb_sim.model.constants import GRAVITY
 from ttb_sim.model.damage import SCOUR_RESIDUAL
+from ttb_sim.model.foundation.operator import spring_pier
+from ttb_sim.model.foundation.records import Substructure
 from ttb_sim.model.foundation.substructure import materials
 from ttb_sim.model.vehicle.payload import loaded_car
 from ttb_sim.sim import build_structure, build_vehicle, Simulation
+import ttb_sim.sim.build as build
 from ttb_sim.validation.cases.damage import first_bending_frequency, girder_damage
 from ttb_sim.validation.references.stepped_beam import SteppedBeam
 
@@ -219,6 +223,30 @@ def test_scour_removes_the_soil_above_the_depth_and_piles_lose_their_modulus() -
     assert other.piles is not None and s.piles is not None
     young = materials(other).young
     assert young[len(other.soil.layers)] == pytest.approx(0.75 * s.piles.E, rel=1e-15)
+
+
+def test_each_piled_pier_stands_on_its_own_damaged_ground(monkeypatch) -> None:
+    """Piers 3 and 4 piled, pier 3 scoured: two substructures; undamaged: one, shared."""
+    specs: list[Substructure] = []
+
+    def spring_founded(scenario: Scenario, spec: Substructure | None = None) -> object:
+        specs.append(spec if spec is not None else scenario.substructure())
+        fd, pr = scenario.foundation, scenario.piers
+        k = np.array([fd.lateral_stiffness] * 2 + [fd.vertical_stiffness]
+                     + [fd.rotational_stiffness] * 3)
+        return spring_pier(pr.height, pr.elements, pier_section(pr), k, np.zeros(6), (0.0, 0.0))
+
+    monkeypatch.setattr(build, 'build_foundation', spring_founded)
+    piled = ['bridge.n_spans=4', 'foundation.model=piled', 'foundation.piled_piers=[3, 4]',
+             'cap.enabled=true', 'bearings.model=elastic']
+    st = build_structure(load_scenario('ten_span_train', piled))
+    assert len(specs) == 1 and st.piled[0].operator is st.piled[1].operator
+    specs.clear()
+    st = build_structure(load_scenario('ten_span_train', [*piled, 'damage.scour=[{pier: 3, '
+                                                          'depth: 1.5}]']))
+    assert len(specs) == 2 and st.piled[0].operator is not st.piled[1].operator
+    assert specs[0].soil.layers[0].E == pytest.approx(
+        specs[1].soil.layers[0].E * SCOUR_RESIDUAL)
 
 
 # --------------------------------------------------------------------------------------
