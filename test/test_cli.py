@@ -45,7 +45,7 @@ def test_a_section_given_to_set_is_named_as_a_section(tmp_path: Path, capsys):
     assert main(['run', 'moving_force_beam', '--out', str(out), '--set', 'train=5']) == 2
     assert capsys.readouterr().err == (
         'ttb-sim: error: train = 5: train is a section, not a value; set one of its keys, e.g. '
-        'train.speed_kmh (its 11 keys: train.vehicle, train.speed_kmh, train.start_position, '
+        'train.speed_kmh (its 12 keys: train.vehicle, train.speed_kmh, train.start_position, '
         'train.axle_offsets, ...; see `ttb-sim scenarios --keys`)\n')
     assert not out.exists()
 

@@ -38,8 +38,8 @@ BRIDGE = ['bridge.n_spans=4', 'solver.dt=2e-4', 'solver.duration=3.0', 'output.r
 PILED = ['foundation.model=piled', 'foundation.piled_piers=[3]', 'cap.enabled=true']
 
 
-def springs_operator(scenario):
-    """Return the spring-founded pier of ``scenario`` as a substructure."""
+def springs_operator(scenario, spec=None):
+    """Return the spring-founded pier of ``scenario`` as a substructure (``spec`` unused)."""
     fd, pr, b = scenario.foundation, scenario.piers, scenario.bridge
     f1 = span_frequency(b.span_length, b.bending_stiffness, b.mass_per_length)
     k = np.array([fd.lateral_stiffness] * 2 + [fd.vertical_stiffness]

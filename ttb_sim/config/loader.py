@@ -376,4 +376,7 @@ def load_scenario(source: str | Path, overrides: Sequence[str] = (),
                             f'{shown(data)}')
     data.setdefault('name', path.stem)
     apply_overrides(data, [parse_override(o) for o in overrides] + list(values))
-    return from_mapping(data)
+    scenario = from_mapping(data)
+    from ttb_sim.config.conditions import check_conditions  # imports the model records
+    check_conditions(scenario)
+    return scenario

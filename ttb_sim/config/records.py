@@ -45,6 +45,8 @@ from ttb_sim.errors import ScenarioError
 from ttb_sim.inputs import shown
 from ttb_sim.model.bearings import BearingParameters
 from ttb_sim.model.bridge import BridgeParameters, PierParameters, span_frequency
+from ttb_sim.model.damage import DamageParameters
+from ttb_sim.model.environment import EnvironmentParameters
 from ttb_sim.model.foundation.consistency import check_substructure
 from ttb_sim.model.foundation.pier_foundations import FoundationParameters
 from ttb_sim.model.foundation.records import (Cap, Interface, Observation, PileGroup, PileLoad,
@@ -90,6 +92,10 @@ class TrainConfig:
                                         low_inclusive=False)
     suspension_damping: float = param(0.0, 'N*s/m', 'Suspension damping of each quarter car.',
                                       low=0.0, high=1e9)
+    passenger_load: float = param(0.0, 'kg', 'Passenger load per car, carried by the car '
+                                  'body (multibody cars: body mass and inertias; quarter cars: '
+                                  'sprung mass; moving forces: m g per car; docs/damage.md).',
+                                  low=0.0, high=1e5)
 
     @property
     def speed(self) -> float:
@@ -216,6 +222,8 @@ class Scenario:
     cap: Cap = field(default_factory=Cap)
     interface: Interface = field(default_factory=Interface)
     load: PileLoad = field(default_factory=PileLoad)
+    damage: DamageParameters = field(default_factory=DamageParameters)
+    environment: EnvironmentParameters = field(default_factory=EnvironmentParameters)
     solver: SolverConfig = field(default_factory=SolverConfig)
     output: OutputConfig = field(default_factory=OutputConfig)
     sensors: tuple[SensorConfig, ...] = param(

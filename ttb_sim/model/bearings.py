@@ -178,13 +178,17 @@ def rigid_ends(ends: np.ndarray, end_support: np.ndarray) -> RigidEnds:
 
 
 def bearing_links(br: BearingParameters, ends: np.ndarray, end_support: np.ndarray,
-                  pier_top: np.ndarray, moving: np.ndarray) -> BearingLinks:
+                  pier_top: np.ndarray, moving: np.ndarray,
+                  stiffness_factors: np.ndarray | None = None) -> BearingLinks:
     """
     Return the elastic bearings as links between girder ends and pier tops (or ground).
 
     ``moving`` marks the supports (partitioned piled piers) whose pier top is not
     a node of the structure: their links are assembled as on ground, but the
     kinematics keep the pier-top arm for the substructure's motion.
+    ``stiffness_factors`` (n_supports, 2), if given, multiply the three stiffnesses of
+    the bearings of each support and side (damage,
+    :func:`ttb_sim.model.damage.bearing_stiffness_factors`).
 
     Returns
     -------
@@ -202,6 +206,8 @@ def bearing_links(br: BearingParameters, ends: np.ndarray, end_support: np.ndarr
     kin = link_kinematics(arm, np.where(((top >= 0) | moving[support])[:, None], arm, 0.0))
     kdir = np.tile([br.longitudinal_stiffness, br.lateral_stiffness,
                     br.vertical_stiffness], (side.size, 1))
+    if stiffness_factors is not None:
+        kdir = kdir * stiffness_factors[support, side][:, None]
     cdir = np.tile([br.lateral_damping, br.lateral_damping, br.vertical_damping],
                    (side.size, 1))
     node_b = np.where(top >= 0, top, 0)

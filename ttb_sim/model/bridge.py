@@ -26,7 +26,7 @@ foundations and the assembled structure are in :mod:`.bearings`,
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 import math
 
 import numpy as np
@@ -196,9 +196,14 @@ class BeamBlock:
     """Section of each element."""
 
 
-def girder_block(b: BridgeParameters) -> tuple[BeamBlock, np.ndarray]:
+def girder_block(b: BridgeParameters, bending_factors: np.ndarray | None = None
+                 ) -> tuple[BeamBlock, np.ndarray]:
     """
     Return the girders (nodes 0.., ``elements_per_span`` elements per span) and their nodes.
+
+    ``bending_factors`` (n_spans * elements_per_span,), if given, multiply the vertical
+    bending stiffness of each element (damage,
+    :func:`ttb_sim.model.damage.girder_bending_factors`).
 
     Returns
     -------
@@ -214,6 +219,8 @@ def girder_block(b: BridgeParameters) -> tuple[BeamBlock, np.ndarray]:
     section = _uniform_section(elements.shape[0], b.axial_stiffness, b.torsional_stiffness,
                                b.bending_stiffness, b.lateral_bending_stiffness,
                                b.mass_per_length, b.torsional_inertia)
+    if bending_factors is not None:
+        section = replace(section, ei_y=section.ei_y * bending_factors)
     coords = np.column_stack([xg, np.zeros_like(xg), np.zeros_like(xg)])
     return BeamBlock(coords, elements, section), girder_nodes
 

@@ -166,10 +166,10 @@ class _Beams:
 
 def _beams(b: BridgeParameters, pr: PierParameters, fd: FoundationParameters,
            piled: tuple[int, ...], track_parameters: TrackParameters | None,
-           train_length: float) -> _Beams:
+           train_length: float, girder_bending: np.ndarray | None = None) -> _Beams:
     """Return the girders, the piers (but the piled ones) and the track as one numbering."""
     n_spans, ne, span = b.n_spans, b.elements_per_span, b.span_length
-    girders, girder_nodes = girder_block(b)
+    girders, girder_nodes = girder_block(b, girder_bending)
     blocks = [girders]
     n_girder_nodes = girder_nodes.size
     pier_top = np.full(n_spans + 1, -1)
@@ -233,7 +233,8 @@ def _girder_ends(beams: _Beams) -> tuple[np.ndarray, np.ndarray]:
     return ends, end_support
 
 
-def _bearings(br: BearingParameters, beams: _Beams, blocks: PiledBlocks, moving: np.ndarray
+def _bearings(br: BearingParameters, beams: _Beams, blocks: PiledBlocks, moving: np.ndarray,
+              factors: np.ndarray | None = None
               ) -> tuple[RigidEnds | None, BearingLinks | None]:
     """
     Return the rigid girder ends or the elastic bearings (the other None).
@@ -244,7 +245,7 @@ def _bearings(br: BearingParameters, beams: _Beams, blocks: PiledBlocks, moving:
     ends, end_support = _girder_ends(beams)
     if br.model == 'rigid':
         return rigid_ends(ends, end_support), None
-    return None, bearing_links(br, ends, end_support, blocks.pier_top, moving)
+    return None, bearing_links(br, ends, end_support, blocks.pier_top, moving, factors)
 
 
 def _dof_map(beams: _Beams, blocks: PiledBlocks, constrained: np.ndarray) -> DofMap:
@@ -277,7 +278,8 @@ def assemble_structure(b: BridgeParameters, br: BearingParameters, pr: PierParam
                        fd: FoundationParameters, track_parameters: TrackParameters | None,
                        train_length: float,
                        foundations: Mapping[int, FoundationOperator] | None = None,
-                       monolithic: bool = False) -> Structure:
+                       monolithic: bool = False, girder_bending: np.ndarray | None = None,
+                       bearing_stiffness: np.ndarray | None = None) -> Structure:
     """
     Assemble girders, bearings, piers, foundations and the slab track (once).
 
@@ -299,6 +301,12 @@ def assemble_structure(b: BridgeParameters, br: BearingParameters, pr: PierParam
     monolithic
         Make the substructures' coordinates DOFs of the structure ([P] Eq. 11)
         instead of leaving them to a partitioned driver (Eq. 12).
+    girder_bending
+        Factor on the vertical bending stiffness of each girder element (damage);
+        None: all 1.
+    bearing_stiffness
+        (n_spans + 1, 2) factor on the stiffness of the bearings of each support and
+        side (damage); None: all 1.
 
     Returns
     -------
@@ -306,7 +314,7 @@ def assemble_structure(b: BridgeParameters, br: BearingParameters, pr: PierParam
 
     """
     piled = tuple(sorted((foundations or {}).keys()))
-    beams = _beams(b, pr, fd, piled, track_parameters, train_length)
+    beams = _beams(b, pr, fd, piled, track_parameters, train_length, girder_bending)
     # monolithic substructures: their coordinates as pseudo-nodes after the beams, the
     # pier top first (q[:6] is one node), the padding of the last node constrained
     blocks = piled_blocks(foundations or {}, piled if monolithic else (), beams.n_nodes,
@@ -325,7 +333,7 @@ def assemble_structure(b: BridgeParameters, br: BearingParameters, pr: PierParam
     constrained[blocks.padding] = True
     moving = np.zeros(b.n_spans + 1, dtype=bool)
     moving[list(piled)] = not monolithic
-    ends_rigid, links_elastic = _bearings(br, beams, blocks, moving)
+    ends_rigid, links_elastic = _bearings(br, beams, blocks, moving, bearing_stiffness)
     if ends_rigid is not None:
         constrained[ends_rigid.full_dofs] = True
     if links_elastic is not None:

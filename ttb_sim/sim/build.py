@@ -29,15 +29,20 @@ from typing import Sequence
 import numpy as np
 
 from ttb_sim.config import car_layout, Scenario
+from ttb_sim.config.conditions import (bearing_factors, check_conditions, conditioned_bearings,
+                                       conditioned_bridge, girder_bending, pier_substructure)
 from ttb_sim.config.sensor_places import ProbeRequest
 from ttb_sim.errors import ScenarioError
 from ttb_sim.fe.beam import field_rows, point_rows
 from ttb_sim.inputs import shown
 from ttb_sim.model.beam_line import BeamLine
 from ttb_sim.model.bridge import pier_section, rayleigh_coefficients, span_frequency
+from ttb_sim.model.constants import GRAVITY
 from ttb_sim.model.foundation.operator import FoundationOperator
+from ttb_sim.model.foundation.records import Substructure
 from ttb_sim.model.irregularity import load_csv, synthesize, TrackIrregularity
 from ttb_sim.model.structure import assemble_structure, Structure
+from ttb_sim.model.vehicle.payload import loaded_car, mass_per_axle
 from ttb_sim.model.vehicle.train import Axles, MovingForces, MultibodyCars, QuarterCars, Vehicle
 from ttb_sim.sim.coupling import (Coupling, MovingForceCoupling, QuarterCarTrain,
                                   ReducedTrainTrackCoupling, TrainTrackCoupling)
@@ -60,31 +65,48 @@ def train_length(scenario: Scenario) -> float:
 
 
 def build_structure(scenario: Scenario) -> Structure:
-    """Assemble the bridge (and slab track, and piled piers) of a scenario, once."""
+    """
+    Assemble the bridge (and slab track, and piled piers) of a scenario, once.
+
+    The ``damage`` and ``environment`` sections act here (:mod:`ttb_sim.config.conditions`):
+    the girders and bearings at the temperature, the damaged girder elements and
+    bearings, and each piled pier on its own (scoured, damaged, scaled) ground.
+    """
+    check_conditions(scenario)
     track = scenario.track if scenario.track.model == 'slab' else None
     fd = scenario.foundation
     foundations = None
     if fd.model == 'piled':
-        operator = build_foundation(scenario)  # every piled pier stands on the same ground
-        foundations = {support: operator for support in fd.piled}
-    return assemble_structure(scenario.bridge, scenario.bearings, scenario.piers, fd, track,
-                              train_length(scenario), foundations,
-                              monolithic=scenario.solver.coupling == 'monolithic')
+        foundations = {}
+        built: dict[Substructure, FoundationOperator] = {}
+        for support in fd.piled:  # piers on the same ground share one operator
+            spec = pier_substructure(scenario, support + 1)
+            if spec not in built:
+                built[spec] = build_foundation(scenario, spec)
+            foundations[support] = built[spec]
+    return assemble_structure(conditioned_bridge(scenario), conditioned_bearings(scenario),
+                              scenario.piers, fd, track, train_length(scenario), foundations,
+                              monolithic=scenario.solver.coupling == 'monolithic',
+                              girder_bending=girder_bending(scenario),
+                              bearing_stiffness=bearing_factors(scenario))
 
 
-def build_foundation(scenario: Scenario) -> FoundationOperator:
+def build_foundation(scenario: Scenario, spec: Substructure | None = None
+                     ) -> FoundationOperator:
     """
     Return the substructure of a piled pier: its column on the cap-pile-soil block.
 
     The pier column is damped like the bridge's beams (Rayleigh, the girder's
-    ratio at its first and fourth bending frequencies); the soil, piles and cap
-    as their own records say.
+    ratio at its first and fourth bending frequencies, at the temperature); the
+    soil, piles and cap as their own records say, or as ``spec`` (a pier's
+    damaged ground, :func:`ttb_sim.config.conditions.pier_substructure`) says.
     """
     from ttb_sim.model.foundation.reduction import pile_soil_operator
 
-    b, pr = scenario.bridge, scenario.piers
+    b, pr = conditioned_bridge(scenario), scenario.piers
     f1 = span_frequency(b.span_length, b.bending_stiffness, b.mass_per_length)
-    operator = pile_soil_operator(scenario.substructure(), pr.height, pr.elements,
+    spec = scenario.substructure() if spec is None else spec
+    operator = pile_soil_operator(spec, pr.height, pr.elements,
                                   pier_section(pr),
                                   rayleigh_coefficients(b.damping_ratio, f1, 4 * f1),
                                   scenario.soil.reduction)
@@ -121,11 +143,12 @@ def build_vehicle(scenario: Scenario) -> Vehicle:
         layout = car_layout(train, scenario.car)
         return MultibodyCars(axles=Axles(offsets=np.asarray(layout, dtype=float)),
                              n_cars=train.n_cars, car_length=train.car_length)
-    if train.vehicle == 'moving_force':
-        return MovingForces(axles=axles, loads=np.full(n, train.axle_load))
     # axles of the car layout are published per car; axles placed by hand one per car
     per_car = n // train.n_cars if not train.axle_offsets and n % train.n_cars == 0 else 1
-    return QuarterCars(axles=axles, sprung_mass=np.full(n, train.sprung_mass),
+    payload = mass_per_axle(train.passenger_load, per_car)  # train.passenger_load
+    if train.vehicle == 'moving_force':
+        return MovingForces(axles=axles, loads=np.full(n, train.axle_load + payload * GRAVITY))
+    return QuarterCars(axles=axles, sprung_mass=np.full(n, train.sprung_mass + payload),
                        unsprung_mass=np.full(n, train.unsprung_mass),
                        stiffness=np.full(n, train.suspension_stiffness),
                        damping=np.full(n, train.suspension_damping), axles_per_car=per_car)
@@ -194,11 +217,12 @@ def build_coupling(scenario: Scenario, structure: Structure, vehicle: Vehicle,
 
     """
     if isinstance(vehicle, MultibodyCars):
+        car = loaded_car(scenario.car, scenario.train.passenger_load)
         if reduced:
-            return ReducedTrainTrackCoupling(scenario.car, scenario.contact, vehicle.n_cars,
+            return ReducedTrainTrackCoupling(car, scenario.contact, vehicle.n_cars,
                                              vehicle.car_length, structure, integrator,
                                              irregularity, scenario.solver.window_margin)
-        return TrainTrackCoupling(scenario.car, scenario.contact, vehicle.n_cars,
+        return TrainTrackCoupling(car, scenario.contact, vehicle.n_cars,
                                   vehicle.car_length, structure, integrator, irregularity)
     if isinstance(vehicle, QuarterCars):
         return QuarterCarTrain(vehicle, structure, integrator, irregularity)
