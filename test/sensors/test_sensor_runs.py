@@ -173,3 +173,19 @@ def test_same_scenario_same_bits(tmp_path, sensed_bag):
         assert np.array_equal(a.stamp_ns, b.stamp_ns)
         for field in a.fields:
             assert np.array_equal(a.fields[field], b.fields[field])
+
+
+def test_labels_carry_the_damage_and_environment_state(tmp_path):
+    out = tmp_path / 'damaged'
+    assert main(['run', 'moving_force_beam', '--out', str(out), '--set',
+                 'damage.girder=[{span: 1, position: 16, length: 4, stiffness_loss: 0.3}]',
+                 '--set', 'environment.temperature=-5', '--set',
+                 'train.passenger_load=5000']) == 0
+    labels = json.loads((out / 'summary.json').read_text())['labels']
+    assert labels['damage']['girder'] == [{'span': 1, 'position': 16.0, 'length': 4.0,
+                                           'stiffness_loss': 0.3}]
+    assert labels['environment']['temperature'] == -5.0
+    assert labels['train']['passenger_load'] == 5000.0
+    metadata = yaml.safe_load((out / 'metadata.yaml').read_text())
+    stored = metadata['rosbag2_bagfile_information']['custom_data']['ttb_sim.labels']
+    assert json.loads(stored) == labels
