@@ -42,7 +42,11 @@ Publishers and their QoS (all explicit):
   RViz gets the structure and the latest train position);
 - ``/tf_static`` (``tf2_msgs/msg/TFMessage``, when tf2_msgs is installed): reliable,
   transient local, keep last 1, one message once the model is built: the frames of
-  :mod:`ttb_sim.node.frames_tf` under ``track``.
+  :mod:`ttb_sim.node.frames_tf` under ``track``;
+- ``~/sensors/<name>`` (the scenario's virtual sensors, docs/sensors.md): as the data
+  topics, each sample once, at the sensor's own sample times;
+- ``~/labels`` (``std_msgs/msg/String``, JSON): latched (reliable, transient local, keep
+  last 1), at every passage and speed change.
 
 The library's log records (:mod:`logging`) go to the node's ROS logger, each warning
 once per node life (:mod:`ttb_sim.node.logs`); BLAS is held at one thread
@@ -81,6 +85,7 @@ from rosgraph_msgs.msg import Clock as ClockMsg
 from rosidl_runtime_py.utilities import get_message
 from std_srvs.srv import SetBool, Trigger
 from ttb_sim.errors import ModelError, ScenarioError
+from ttb_sim.io.sensor_topics import extra_topics
 from ttb_sim.io.topics import Topic, topic_table
 from ttb_sim.node import (markers, NodeParameter, PassageController, validate_changes,
                           validate_parameter)
@@ -234,6 +239,7 @@ class SimulatorNode(Node):
         self.topics: list[Topic] = []
         self.publishers_by_name: dict[str, Any] = {}
         self._live: list[Any] = []
+        self._extra_pubs: list[Any] = []   # ~/labels, then ~/sensors/<name> in order
         self._messages: MessageCache | None = None
         self.fatal = Future()
         self._fatal: tuple[str, int] = ('', 0)
@@ -325,7 +331,8 @@ class SimulatorNode(Node):
 
     def _open_recorder(self, path: Path, storage: str, layout: Layout) -> FrameSink:
         """Open the bag (on the stepping thread, which also writes and closes it)."""
-        recorder = open_bag(path, storage, layout, self.namespace)
+        recorder = open_bag(path, storage, layout, self.namespace,
+                            extra_topics(self.scenario.all_sensors))
         self._log('info', f'recording to {path} ({storage})')
         return recorder
 
@@ -362,6 +369,12 @@ class SimulatorNode(Node):
             self.publishers_by_name[topic.name] = self.create_publisher(
                 message_class(topic.msgtype), name, QOS[qos_class(topic.qos, reliability)])
         self._live = [self.publishers_by_name[t.name] for t, _ in live]
+        if controller.sensing is not None:
+            self._extra_pubs = [
+                self.create_publisher(message_class(msgtype), f'~/{name}',
+                                      QOS['latched' if index == 0 else
+                                          qos_class('data', reliability)])
+                for index, (name, msgtype) in enumerate(controller.sensing.extra)]
         self._messages = MessageCache([t for t, _ in live], message_class)
         self._narrow_rate_ranges(controller.output_period)
         if self.tf_static_pub is not None:
@@ -458,6 +471,7 @@ class SimulatorNode(Node):
         """Log passage events and hand the frames to the publisher (stepping thread)."""
         for level, message in tick_messages(tick, self.controller):
             self._log(level, message)
+        self._publish_sensing(tick)
         if self.publish_loop is not None:
             self.publish_loop.offer(list(zip(tick.frames, tick.due)), tick.markers)
 
@@ -478,6 +492,22 @@ class SimulatorNode(Node):
                     self._live[index].publish(msg)
             if refresh_markers and items:
                 self._publish_markers(items[-1][0].head_position)
+        except Exception as exc:  # noqa: B902 - shutting down under our feet
+            if self.context.ok() and not self._closed:
+                raise
+            self._log('debug', f'publishing stopped at shutdown: {exc}')
+
+    def _publish_sensing(self, tick: Tick) -> None:
+        """Publish the labels when they changed and every sensor sample (stepping thread)."""
+        controller = self.controller
+        sensing = controller.sensing if controller is not None else None
+        if sensing is None or not self._extra_pubs or self._closed or not self.context.ok():
+            return
+        try:
+            if tick.labels:
+                self._extra_pubs[0].publish(sensing.labels_message(message_class))
+            for sample in tick.samples:
+                self._extra_pubs[sample.index].publish(sensing.message(message_class, sample))
         except Exception as exc:  # noqa: B902 - shutting down under our feet
             if self.context.ok() and not self._closed:
                 raise

@@ -124,12 +124,11 @@ def run_to_bag(scenario: Scenario, out: str | Path, storage: str = 'mcap',
     try:
         with BagRecorder(out, topics, storage, extra=sensing.extra) as bag:
             bag.set_custom_data(LABELS_KEY, json.dumps(sensing.labels, sort_keys=True))
-            bag.write_message(*sensing.labels_message(bag.types))
+            sensing.write_labels(bag, 0)
             try:
                 for frame in sim.frames():
                     bag.write(frame)
-                    for message in sensing.push(frame, bag.types):
-                        bag.write_message(*message)
+                    sensing.write(bag, sensing.push(frame))
                     peaks.update(frame)
                     done.frames += 1
                     done.last_time = frame.time
@@ -139,8 +138,7 @@ def run_to_bag(scenario: Scenario, out: str | Path, storage: str = 'mcap',
                         done.status, done.message = 'interrupted', 'stopped by a signal'
                         break
             finally:   # the samples of the frames written, whatever ended the run
-                for message in sensing.flush(bag.types):
-                    bag.write_message(*message)
+                sensing.write(bag, sensing.flush())
     except SimulationError as exc:  # divergence, interface iterations that fail
         done.status, done.message = 'diverged', str(exc)
     except KeyboardInterrupt:

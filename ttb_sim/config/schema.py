@@ -199,6 +199,9 @@ def from_mapping(data: Mapping[str, Any], cls: type | None = None, prefix: str =
             raise ScenarioError(f'unknown key {shown(path)}; allowed here: {allowed}')
         f = names[key]
         if 'spec' in f.metadata:
+            if isinstance(value, (list, tuple)) and not value and f.default == ():
+                kwargs[key] = ()   # an optional list given empty: as if left out
+                continue
             kwargs[key] = _coerce(path, value, hints[key], f.metadata['spec'])
         else:
             kwargs[key] = from_mapping(value, hints[key], prefix=f'{path}.')

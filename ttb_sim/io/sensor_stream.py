@@ -17,14 +17,18 @@ The sensors and labels of a run as messages: what ``ttb-sim run`` and the node w
 
 :class:`SensorStream` owns the run's :class:`~ttb_sim.sensors.SensorBank` (none
 without sensors), the sensors' topics and the labels. It takes every frame the
-run computes and returns the messages due: the samples of each sensor, as
-``(extra-topic index, stamp, message)``; the labels are extra topic 0, the sensors
-1, 2, ... in order (:func:`~ttb_sim.io.sensor_topics.extra_topics`).
+run computes and returns the samples due (:class:`SensorSample`: extra-topic index,
+stamp, values), which :meth:`SensorStream.message` turns into messages of either
+back-end (rosbags' classes for a bag, rclpy's for the node); the labels are extra
+topic 0, the sensors 1, 2, ... in order (:func:`~ttb_sim.io.sensor_topics.extra_topics`).
 """
 
 from __future__ import annotations
 
-from typing import Any, Iterator, Sequence
+from dataclasses import dataclass
+from typing import Any, Iterator, Protocol, runtime_checkable, Sequence
+
+import numpy as np
 
 from ttb_sim.config.labels import run_labels
 from ttb_sim.config.records import Scenario
@@ -33,10 +37,31 @@ from ttb_sim.io.topics import MessageTypes
 from ttb_sim.sensors import Samples, SensorBank
 from ttb_sim.sim import Frame, Layout
 
-__all__ = ['SensorStream']
+__all__ = ['MessageSink', 'SensorSample', 'SensorStream']
 
-Message = tuple[int, int, Any]
-"""(extra-topic index, stamp in ns, message)."""
+
+@runtime_checkable
+class MessageSink(Protocol):
+    """What takes the messages of the extra topics one by one (a BagRecorder)."""
+
+    @property
+    def types(self) -> MessageTypes:
+        """The map from a type name to the sink's message class."""
+
+    def write_message(self, index: int, stamp_ns: int, message: Any) -> None:
+        """Write one message of the ``index``-th extra topic."""
+
+
+@dataclass(frozen=True)
+class SensorSample:
+    """One recorded sample of one sensor."""
+
+    index: int
+    """Extra-topic index (1 + the sensor's place in the run's sensors)."""
+    stamp_ns: int
+    """Its stamp: true sample time plus the sensor's clock offset (ns)."""
+    xyz: np.ndarray
+    """(3,) its values on x, y, z (zeros on the axes it does not measure)."""
 
 
 class SensorStream:
@@ -75,33 +100,44 @@ class SensorStream:
         """True when the sensors need every frame of the run (there are sensors)."""
         return self.bank is not None
 
-    def relabel(self, scenario: Scenario, types: MessageTypes, stamp_ns: int) -> Message:
-        """Take the labels of a new passage (or state); return their message."""
+    def relabel(self, scenario: Scenario) -> None:
+        """Take the labels of a new passage (its speed, irregularity, state)."""
         self.labels = run_labels(scenario)
-        return self.labels_message(types, stamp_ns)
 
-    def labels_message(self, types: MessageTypes, stamp_ns: int = 0) -> Message:
-        """Return the labels' message (extra topic 0)."""
-        return 0, int(stamp_ns), labels_message(types, self.labels)
+    def labels_message(self, types: MessageTypes) -> Any:
+        """Return the labels' message (extra topic 0) in the classes of ``types``."""
+        return labels_message(types, self.labels)
 
-    def push(self, frame: Frame, types: MessageTypes) -> list[Message]:
-        """Give one frame to the sensors; return the messages of the samples they return."""
+    def message(self, types: MessageTypes, sample: SensorSample) -> Any:
+        """Return a sample's message in the classes of ``types``."""
+        return self.topics[sample.index - 1].message(types, sample.stamp_ns, sample.xyz)
+
+    def write_labels(self, sink: MessageSink, stamp_ns: int) -> None:
+        """Write the labels' message to a sink."""
+        sink.write_message(0, stamp_ns, self.labels_message(sink.types))
+
+    def write(self, sink: MessageSink, samples: Sequence[SensorSample]) -> None:
+        """Write samples' messages to a sink."""
+        for sample in samples:
+            sink.write_message(sample.index, sample.stamp_ns, self.message(sink.types, sample))
+
+    def push(self, frame: Frame) -> list[SensorSample]:
+        """Give one frame to the sensors; return the samples they record from the block."""
         if self.bank is None:
             return []
-        return list(self._messages(self.bank.push(frame), types))
+        return list(self._samples(self.bank.push(frame)))
 
-    def flush(self, types: MessageTypes) -> list[Message]:
-        """Return the messages of the frames the sensors still keep."""
+    def flush(self) -> list[SensorSample]:
+        """Return the samples of the frames the sensors still keep."""
         if self.bank is None:
             return []
-        return list(self._messages(self.bank.flush(), types))
+        return list(self._samples(self.bank.flush()))
 
-    def _messages(self, batches: Sequence[tuple[int, Samples]],
-                  types: MessageTypes) -> Iterator[Message]:
+    def _samples(self, batches: Sequence[tuple[int, Samples]]) -> Iterator[SensorSample]:
         for index, samples in batches:
             topic = self.topics[index]
             for stamp, xyz in zip(samples.stamps_ns, topic.spread(samples.values)):
-                yield index + 1, int(stamp), topic.message(types, int(stamp), xyz)
+                yield SensorSample(index + 1, int(stamp), xyz)
 
     def describe(self) -> list[dict[str, Any]]:
         """Return the sensors for ``summary.json`` (none without sensors)."""

@@ -43,6 +43,7 @@ from typing import Any, Callable, Iterator, Mapping
 
 from ttb_sim.config import Scenario
 from ttb_sim.errors import DivergenceError, ScenarioError, TtbSimError
+from ttb_sim.io.sensor_stream import MessageSink, SensorSample, SensorStream
 from ttb_sim.io.topics import topic_table
 from ttb_sim.node.diagnostics import (DiagnosticsReport, frame_values, passage_level,
                                       SlidingWindow, StepMeter)
@@ -88,6 +89,10 @@ class Tick:
         True when the train markers should be refreshed.
     events : list of str
         Passage events of this tick ('ended', 'restarted', 'idle', 'diverged').
+    samples : list of SensorSample
+        What the virtual sensors recorded in this tick (published at once, not decimated).
+    labels : bool
+        True when the labels changed (a new passage, a speed change): publish them.
 
     """
 
@@ -97,6 +102,8 @@ class Tick:
     sleep: float = 0.0
     markers: bool = False
     events: list[str] = field(default_factory=list)
+    samples: list[SensorSample] = field(default_factory=list)
+    labels: bool = False
 
 
 class PassageController:
@@ -156,6 +163,10 @@ class PassageController:
         self.simulated = 0.0
         """Simulated seconds stepped over the node's life (all passages)."""
         self._base_every = 1
+        self.sensing: SensorStream | None = None
+        """The virtual sensors and the labels (built with the first passage)."""
+        self._sensing_rate = 0.0
+        self._labels_due = False
         self._start_passage()
         ok, reason = self.check_rates(self.values)
         if not ok:
@@ -183,6 +194,7 @@ class PassageController:
             if name == 'train.speed_kmh':
                 if self._train is not None:
                     self._train.set_speed(value / 3.6)
+                    self._relabel(self.passage_scenario())
                 else:
                     log.info('train.speed_kmh has no effect on a substructure run')
             elif name == 'real_time_factor':   # the new pace counts from now
@@ -226,6 +238,7 @@ class PassageController:
         """
         with self._lock:
             self.state = 'stopped'
+            self._flush_sensors()
             self._close_recorder()
 
     # -- stepping -----------------------------------------------------------------------
@@ -299,6 +312,7 @@ class PassageController:
                 tick.sleep = 0.1
                 return tick
             self._set_frame_stride()
+            self._emit_labels(tick)
             now = self._clock()
             if self._run_started is None:
                 self._run_started = now
@@ -316,6 +330,7 @@ class PassageController:
                 self._step_one(tick)
                 if time.perf_counter() > deadline:
                     break
+            self._flush_sensors(tick)   # every sample of this tick's frames goes out now
             self._meter.stepping(time.perf_counter() - started, time.thread_time() - started_cpu)
             if self.state == 'running' and rtf > 0:
                 due = wall0 + (self._node_time + self.frame_period - sim0) / rtf
@@ -345,6 +360,7 @@ class PassageController:
             self.divergence = str(exc)
             tick.events.append('diverged')
             log.debug('simulation diverged: %s; stepping stopped, bag closed', exc)
+            self._flush_sensors()
             self._close_recorder()
             return
         frame = replace(raw, time=self.time_offset + raw.time)
@@ -353,6 +369,10 @@ class PassageController:
         self._meter.frame(self.sim.output_every, self.frame_period if raw.step else 0.0)
         self.simulated += self.frame_period if raw.step else 0.0
         self._record(frame)
+        if self.sensing is not None:
+            samples = self.sensing.push(frame)
+            tick.samples.extend(samples)
+            self._record_samples(samples)
         due = self._schedule.due(frame.time, self.publish_periods())
         if due:
             tick.frames.append(frame)
@@ -374,7 +394,8 @@ class PassageController:
         if sim is None:
             return
         stride = 1
-        if self.recorder is None:
+        sensors = self.sensing is not None and self.sensing.samples_every_frame
+        if self.recorder is None and not sensors:
             stride = frame_stride(self.publish_periods(), self.output_period)
         sim.output_every = self._base_every * stride
 
@@ -444,6 +465,7 @@ class PassageController:
             present = {family_of(t.name) for t in topic_table(self.sim.layout)}
             self._families = tuple(f for f in FAMILIES if f in present) or ('',)
             self._schedule = Schedule(self._families, self.time_offset)
+        self._start_sensing(scenario)
         self._frames = self.sim.frames()
         self._exit_time = None
         self.passage += 1
@@ -457,6 +479,57 @@ class PassageController:
         log.debug('passage %d: %s at %.1f km/h, dt = %.3g s', self.passage, scenario.name,
                   scenario.train.speed_kmh, self.sim.dt)
 
+    # -- sensors and labels -------------------------------------------------------------
+
+    def _start_sensing(self, scenario: Scenario) -> None:
+        """Build the sensors with the first passage (again if the frame rate changed)."""
+        rate = 1.0 / (self.sim.dt * self._base_every)
+        if self.sensing is None or abs(self._sensing_rate - rate) > 1e-9 * rate:
+            if self.sensing is not None:
+                log.info('the frame rate changed to %g Hz: the sensors start afresh', rate)
+            self.sensing = SensorStream(scenario, self.sim.layout, self.sim.dt,
+                                        self._base_every)
+            self._sensing_rate = rate
+        self._relabel(scenario)
+
+    def _relabel(self, scenario: Scenario) -> None:
+        """Take the labels of the passage now; publish and record them from the next tick."""
+        if self.sensing is None:
+            return
+        self.sensing.relabel(scenario)
+        self._labels_due = True
+
+    def _emit_labels(self, tick: Tick) -> None:
+        """Hand changed labels to the tick (to publish) and to the recorder."""
+        if not self._labels_due or self.sensing is None:
+            return
+        self._labels_due = False
+        tick.labels = True
+        sink = self.recorder
+        if isinstance(sink, MessageSink):
+            try:
+                self.sensing.write_labels(sink, round(self._node_time * 1e9))
+            except Exception as exc:  # noqa: B902 - any writer failure stops recording only
+                self._recording_failed(exc)
+
+    def _record_samples(self, samples: list[SensorSample]) -> None:
+        sink = self.recorder
+        if not samples or not isinstance(sink, MessageSink):
+            return
+        assert self.sensing is not None
+        try:
+            self.sensing.write(sink, samples)
+        except Exception as exc:  # noqa: B902 - any writer failure stops recording only
+            self._recording_failed(exc)
+
+    def _flush_sensors(self, tick: Tick | None = None) -> None:
+        """Record (and hand to the tick) the samples of the frames the sensors still keep."""
+        if self.sensing is not None:
+            samples = self.sensing.flush()
+            if tick is not None:
+                tick.samples.extend(samples)
+            self._record_samples(samples)
+
     # -- recording ----------------------------------------------------------------------
 
     def _record(self, frame: Frame) -> None:
@@ -466,9 +539,12 @@ class PassageController:
             self.recorder.write(frame)
             self.recorded += 1
         except Exception as exc:  # noqa: B902 - any writer failure stops recording only
-            self.bag_error = f'bag write failed: {exc}'
-            log.error('%s; recording stopped', self.bag_error)
-            self._close_recorder()
+            self._recording_failed(exc)
+
+    def _recording_failed(self, exc: Exception) -> None:
+        self.bag_error = f'bag write failed: {exc}'
+        log.error('%s; recording stopped', self.bag_error)
+        self._close_recorder()
 
     def _recording_stopped(self) -> bool:
         return self.values.get('bag.enabled', False) and self.recorder is None

@@ -30,7 +30,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from pathlib import Path
 import threading
-from typing import Any, Callable, Mapping
+from typing import Any, Callable, Mapping, Sequence
 
 from ttb_sim.config import load_scenario, Scenario
 from ttb_sim.io.bag import BagRecorder, check_destination, default_bag_path, make_parents
@@ -135,10 +135,17 @@ def bag_destination(values: Mapping[str, Any], scenario_name: str) -> Path | Non
     return path
 
 
-def open_bag(path: Path, storage: str, layout: Layout, namespace: str) -> FrameSink:
-    """Open the node's bag of the model's topic table under the node's namespace."""
+def open_bag(path: Path, storage: str, layout: Layout, namespace: str,
+             extra: Sequence[tuple[str, str]] = ()) -> FrameSink:
+    """
+    Open the node's bag of the model's topic table under the node's namespace.
+
+    ``extra``: (name, type) of the topics written message by message, the labels and
+    the sensors (:func:`~ttb_sim.io.sensor_topics.extra_topics`).
+    """
     make_parents(path)
-    return BagRecorder(path, topic_table(layout), storage, namespace=namespace).__enter__()
+    return BagRecorder(path, topic_table(layout), storage, namespace=namespace,
+                       extra=extra).__enter__()
 
 
 class ClockGuard:
