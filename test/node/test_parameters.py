@@ -30,7 +30,8 @@ CONTRACT_PARAMETERS = {
     'scenario', 'train.speed_kmh', 'irregularity.spectrum', 'irregularity.seed',
     'irregularity.file', 'irregularity.scale', 'publish_rate_hz', 'real_time_factor', 'loop',
     'publish_clock', 'bag.enabled', 'bag.path', 'bag.storage'}
-NODE_PARAMETERS = CONTRACT_PARAMETERS | set(RATE_PARAMETERS) | {'qos.reliability'}
+NODE_PARAMETERS = CONTRACT_PARAMETERS | set(RATE_PARAMETERS) | {
+    'qos.reliability', 'environment.temperature', 'train.passenger_load', 'damage'}
 
 
 # -- parameter table ------------------------------------------------------------------------

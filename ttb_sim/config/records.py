@@ -95,7 +95,7 @@ class TrainConfig:
     passenger_load: float = param(0.0, 'kg', 'Passenger load per car, carried by the car '
                                   'body (multibody cars: body mass and inertias; quarter cars: '
                                   'sprung mass; moving forces: m g per car; docs/damage.md).',
-                                  low=0.0, high=1e5)
+                                  low=0.0, high=1e5, dynamic=True)
 
     @property
     def speed(self) -> float:

@@ -304,6 +304,11 @@ class BagRecorder:
         self.messages += 1
 
     @property
+    def extra(self) -> list[tuple[str, str]]:
+        """Return (name, message type) of the extra topics, in :meth:`write_message` order."""
+        return list(self._extra)
+
+    @property
     def types(self) -> Any:
         """Return the map from a type name to its message class (rosbags' typestore)."""
         return self._types

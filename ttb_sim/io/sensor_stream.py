@@ -48,6 +48,10 @@ class MessageSink(Protocol):
     def types(self) -> MessageTypes:
         """The map from a type name to the sink's message class."""
 
+    @property
+    def extra(self) -> list[tuple[str, str]]:
+        """(name, message type) of its extra topics."""
+
     def write_message(self, index: int, stamp_ns: int, message: Any) -> None:
         """Write one message of the ``index``-th extra topic."""
 
@@ -94,6 +98,10 @@ class SensorStream:
         self.extra = extra_topics(sensors)
         """(name, message type) of the labels' topic, then of each sensor's."""
         self.labels = run_labels(scenario)
+
+    def takes(self, sink: object) -> bool:
+        """Tell whether a sink records this stream's topics (labels, then the sensors)."""
+        return isinstance(sink, MessageSink) and sink.extra == self.extra
 
     @property
     def samples_every_frame(self) -> bool:

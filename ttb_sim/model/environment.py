@@ -49,7 +49,8 @@ class EnvironmentParameters:
     """Temperature and ground state (``environment``)."""
 
     temperature: float = param(20.0, 'degC', 'Temperature of the bridge (girders and '
-                               'bearings; uniform, no gradient).', low=-60.0, high=60.0)
+                               'bearings; uniform, no gradient).', low=-60.0, high=60.0,
+                               dynamic=True)
     reference_temperature: float = param(20.0, 'degC', 'Temperature at which the girder and '
                                          'bearing keys hold.', low=-60.0, high=60.0)
     girder_modulus_coefficient: float = param(

@@ -50,7 +50,8 @@ DEFAULT_SCENARIO = 'live_coupled'
 """Scenario loaded when the ``scenario`` parameter is not given."""
 
 SCENARIO_KEYS = ('train.speed_kmh', 'irregularity.spectrum', 'irregularity.seed',
-                 'irregularity.file', 'irregularity.scale')
+                 'irregularity.file', 'irregularity.scale', 'environment.temperature',
+                 'train.passenger_load')
 """Node parameters that are scenario keys (same name, unit, range and description)."""
 
 QOS_RELIABILITIES = ('reliable', 'best_effort')
@@ -60,7 +61,16 @@ INT64 = (-2 ** 63, 2 ** 63 - 1)
 """The range of a ROS integer parameter."""
 
 IRREGULARITY_KEYS = tuple(k for k in SCENARIO_KEYS if k.startswith('irregularity.'))
-"""The scenario-key parameters that apply from the next passage."""
+"""The irregularity parameters (they apply from the next passage)."""
+
+STATE_KEYS = ('environment.temperature', 'train.passenger_load')
+"""Scenario keys of the structure's state and the train's load, set per passage."""
+
+DAMAGE_PARAMETER = 'damage'
+"""The node parameter holding the ``damage`` section as YAML ('' = the scenario's)."""
+
+PASSAGE_KEYS = IRREGULARITY_KEYS + STATE_KEYS + (DAMAGE_PARAMETER,)
+"""The parameters that apply from the next passage (its model is built with them)."""
 
 
 @dataclass(frozen=True)
@@ -157,6 +167,10 @@ _NODE_ONLY: dict[str, tuple[str, Any, Spec, bool]] = {
         '-', "Bag directory to create (must not exist); '' = runs/<scenario>-<time>."), True),
     'bag.storage': ('string', 'mcap', Spec(
         '-', 'rosbag2 storage plugin.', choices=tuple(STORAGES)), True),
+    DAMAGE_PARAMETER: ('string', '', Spec(
+        '-', "The damage section as YAML, e.g. '{girder: [{span: 7, position: 16, length: 4, "
+        "stiffness_loss: 0.3}]}' (docs/damage.md); '' = the scenario's own. The labels and "
+        'the bag show the switch.'), False),
 }
 
 _KIND_OF = {float: 'double', int: 'integer', str: 'string', bool: 'bool'}
@@ -191,13 +205,14 @@ def parameter_table(scenario: Scenario | None = None) -> dict[str, NodeParameter
     for key in SCENARIO_KEYS:
         typ, schema_default, spec = key_spec(key)
         value = schema_default if scenario is None else _scenario_value(scenario, key)
-        applies = 'next passage' if key in IRREGULARITY_KEYS else 'immediately'
+        applies = 'next passage' if key in PASSAGE_KEYS else 'immediately'
         table[key] = NodeParameter(key, _KIND_OF[typ], value, spec, not spec.dynamic,
                                    applies if spec.dynamic else 'restart', key)
     for name, (kind, default, spec, read_only) in _NODE_ONLY.items():
         if name != 'scenario':
+            applies = 'next passage' if name in PASSAGE_KEYS else 'immediately'
             table[name] = NodeParameter(name, kind, default, spec, read_only,
-                                        'restart' if read_only else 'immediately')
+                                        'restart' if read_only else applies)
     return table
 
 
@@ -378,5 +393,36 @@ def scenario_with(scenario: Scenario, values: Mapping[str, Any]) -> Scenario:
 
     """
     data = scenario.to_dict()
+    values = dict(values)
+    damage = values.pop(DAMAGE_PARAMETER, '')
     apply_overrides(data, list(values.items()))
-    return from_mapping(data)
+    if damage:
+        data['damage'] = damage_section(damage)
+    out = from_mapping(data)
+    from ttb_sim.config.conditions import check_conditions
+    check_conditions(out)   # what load_scenario checks beyond the records
+    return out
+
+
+def damage_section(text: str) -> Any:
+    """
+    Parse the ``damage`` parameter: a YAML (or JSON) mapping of the damage section.
+
+    Raises
+    ------
+    ScenarioError
+        Naming the parameter when the text is not YAML or not a mapping.
+
+    """
+    import yaml
+
+    try:
+        data = yaml.safe_load(text)
+    except yaml.YAMLError as exc:
+        raise ScenarioError(f'{DAMAGE_PARAMETER} = {shown(text)}: not YAML '
+                            f'({" ".join(str(exc).split())[:200]})') from None
+    if not isinstance(data, dict):
+        raise ScenarioError(f'{DAMAGE_PARAMETER} = {shown(text)}: expected a mapping such as '
+                            "'{girder: [{span: 7, position: 16, length: 4, stiffness_loss: "
+                            "0.3}]}'")
+    return data

@@ -47,8 +47,9 @@ from ttb_sim.io.sensor_stream import MessageSink, SensorSample, SensorStream
 from ttb_sim.io.topics import topic_table
 from ttb_sim.node.diagnostics import (DiagnosticsReport, frame_values, passage_level,
                                       SlidingWindow, StepMeter)
-from ttb_sim.node.parameters import (IRREGULARITY_KEYS, normalize_value, parameter_table,
-                                     SCENARIO_KEYS, scenario_with)
+from ttb_sim.node.parameters import (DAMAGE_PARAMETER, IRREGULARITY_KEYS, normalize_value,
+                                     parameter_table, PASSAGE_KEYS, SCENARIO_KEYS,
+                                     scenario_with)
 from ttb_sim.node.rates import (check_rate, FAMILIES, family_of, family_periods, frame_stride,
                                 RATE_PARAMETERS, Schedule)
 from ttb_sim.node.runs import FrameSink, TrainRun
@@ -206,7 +207,7 @@ class PassageController:
                 self._schedule.restart(self._node_time, RATE_PARAMETERS[name])
             elif name == 'loop' and value and self.state == 'idle':
                 self._restart()
-            elif name in IRREGULARITY_KEYS:
+            elif name in PASSAGE_KEYS:
                 log.info('%s = %r applies from the next passage', name, value)
 
     def reset(self) -> str:
@@ -272,7 +273,20 @@ class PassageController:
         return family_periods(self.values, self.output_period, self._families)
 
     def check_rates(self, changes: Mapping[str, Any]) -> tuple[bool, str]:
-        """Refuse a per-family rate above this model's output rate (names the limit)."""
+        """
+        Refuse a per-family rate above this model's output rate (names the limit).
+
+        Also refuse next-passage values whose scenario would not build (a damage zone off
+        its span, a temperature that makes a stiffness negative): the reason names them.
+        """
+        state = {k: v for k, v in changes.items() if k in PASSAGE_KEYS}
+        if state:
+            values = {**self.values, **state}
+            keys = SCENARIO_KEYS + (DAMAGE_PARAMETER,)
+            try:
+                scenario_with(self.base, {k: values[k] for k in keys if k in values})
+            except ScenarioError as exc:
+                return False, str(exc)
         for name, value in changes.items():
             if name in RATE_PARAMETERS and isinstance(value, (int, float)):
                 ok, reason = check_rate(name, float(value), self.output_period)
@@ -287,7 +301,8 @@ class PassageController:
 
     def passage_scenario(self) -> Scenario:
         """Return the scenario of a new passage: the base with the current parameters."""
-        return scenario_with(self.base, {k: self.values[k] for k in SCENARIO_KEYS})
+        keys = SCENARIO_KEYS + (DAMAGE_PARAMETER,)
+        return scenario_with(self.base, {k: self.values[k] for k in keys if k in self.values})
 
     def advance(self, budget: float = 0.02, max_frames: int = 100000) -> Tick:
         """
@@ -506,7 +521,8 @@ class PassageController:
         self._labels_due = False
         tick.labels = True
         sink = self.recorder
-        if isinstance(sink, MessageSink):
+        if self.sensing.takes(sink):
+            assert isinstance(sink, MessageSink)
             try:
                 self.sensing.write_labels(sink, round(self._node_time * 1e9))
             except Exception as exc:  # noqa: B902 - any writer failure stops recording only
@@ -514,9 +530,10 @@ class PassageController:
 
     def _record_samples(self, samples: list[SensorSample]) -> None:
         sink = self.recorder
-        if not samples or not isinstance(sink, MessageSink):
-            return
         assert self.sensing is not None
+        if not samples or not self.sensing.takes(sink):
+            return
+        assert isinstance(sink, MessageSink)
         try:
             self.sensing.write(sink, samples)
         except Exception as exc:  # noqa: B902 - any writer failure stops recording only
