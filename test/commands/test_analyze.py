@@ -98,6 +98,13 @@ def test_safety_metrics_of_the_wheels(analysed):
     assert wheel['lateral_wheelset_force_max_N'] == pytest.approx(2 * lateral)
     assert wheel['lateral_wheelset_force_limit_N'] == pytest.approx(10e3 + 2 * static / 3)
     assert m['indices']['derailment_coefficient']['within_limit']
+    # the first wheel's r.m.s.: the tone's amplitude / sqrt(2), all of it below 20 Hz
+    assert wheel['first_wheel_vertical_dynamic_rms_N'] == pytest.approx(amp / math.sqrt(2),
+                                                                         rel=0.01)
+    bands = wheel['first_wheel_vertical_band_rms_N']
+    assert bands['0-20 Hz'] == pytest.approx(amp / math.sqrt(2), rel=0.02)
+    assert bands['20-100 Hz'] < 0.05 * amp and bands['100-500 Hz'] < 0.05 * amp
+    assert wheel['first_wheel_lateral_rms_N'] == pytest.approx(lateral)
 
 
 def test_girder_piles_and_soil(analysed):
@@ -108,6 +115,8 @@ def test_girder_piles_and_soil(analysed):
     pile = m['piles']['pier01_pile01']
     assert pile['vertical_acceleration_peak_m_s2'] == pytest.approx(sb.PILE_A[0], rel=3e-3)
     assert pile['rotation_peak_rad'] == pytest.approx(sb.PILE_ROT[0], rel=0.02)
+    assert pile['vertical_acceleration_rms_m_s2'] == pytest.approx(sb.PILE_A[0] / math.sqrt(2),
+                                                                   rel=0.01)
     points = m['soil']['points']
     assert sorted(points) == ['point_(1.0,_5.0)_m', 'point_(3.0,_5.0)_m']   # off the line
     assert m['soil']['line_peak_acceleration_m_s2'] == pytest.approx(5 * sb.SOIL[0], rel=3e-3)
@@ -115,6 +124,8 @@ def test_girder_piles_and_soil(analysed):
     level = 20 * math.log10(sb.SOIL[0] / math.sqrt(2) / 1e-6)
     assert first['val_max_db'] == pytest.approx(level, abs=1e-6)
     assert first['val_max_band_hz'] == pytest.approx(6.31, abs=0.01)
+    assert first['vertical_acceleration_rms_m_s2'] == pytest.approx(sb.SOIL[0] / math.sqrt(2),
+                                                                    rel=0.01)
     last = points['point_(3.0,_5.0)_m']   # amplitude x5
     assert last['val_max_db'] - first['val_max_db'] == pytest.approx(20 * math.log10(5),
                                                                      abs=1e-6)

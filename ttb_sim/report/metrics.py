@@ -33,6 +33,7 @@ from typing import Any, Sequence
 import numpy as np
 
 from ttb_sim.analysis.excitation import Excitation, excitation_frequencies
+from ttb_sim.analysis.levels import band_rms
 from ttb_sim.analysis.power_flow import power_flow_spectrum, velocity_from_displacement
 from ttb_sim.analysis.psd import (level_change_frequency, peak_frequency,
                                   resolving_segment_seconds, welch_psd)
@@ -266,6 +267,7 @@ def _wheel_rail_metrics(s: Streams) -> tuple[dict[str, Any], dict[str, Any]]:
         metrics['not_available'] = {columns[name]: reason for name, reason in missing.items()}
         metrics.update(dict.fromkeys(metrics['not_available']))
     first = s.wheel_rail[min(s.wheel_rail)]
+    metrics.update(_first_wheel_rms(first))
     junction = next((m.low for m in marks_of(s) if m.label.startswith('V/')), None)
     if junction and first.rate > 4.0 * junction and first.t.size / first.rate >= 2.0:
         # as V19: 0.5 s Welch segments, the step searched within an octave of V / lambda
@@ -278,13 +280,33 @@ def _wheel_rail_metrics(s: Streams) -> tuple[dict[str, Any], dict[str, Any]]:
     return metrics, indices
 
 
+FORCE_BANDS_HZ = ((0.0, 20.0), (20.0, 100.0), (100.0, 500.0))
+"""Bands of the first wheel's force r.m.s. in ``metrics.json`` (Hz; up to Nyquist)."""
+
+
+def _first_wheel_rms(first: Series) -> dict[str, Any]:
+    """Return the first wheel's r.m.s. forces: vertical dynamic part, lateral, by band."""
+    fz, fy = first.values[:, 2], first.values[:, 1]
+    out: dict[str, Any] = {'first_wheel_vertical_dynamic_rms_N': float(np.std(fz)),
+                           'first_wheel_lateral_rms_N': float(np.sqrt(np.mean(fy ** 2)))}
+    if first.t.size >= 2 and first.rate > 0:
+        lower = [lo for lo, _ in FORCE_BANDS_HZ]
+        upper = [hi for _, hi in FORCE_BANDS_HZ]
+        for name, values in (('vertical', fz), ('lateral', fy)):
+            rms = band_rms(values, first.rate, lower, upper)
+            out[f'first_wheel_{name}_band_rms_N'] = {
+                f'{lo:g}-{hi:g} Hz': float(r) for (lo, hi), r in zip(FORCE_BANDS_HZ, rms)}
+    return out
+
+
 def _pile_metrics(s: Streams) -> dict[str, Any]:
     piles: dict[str, Any] = {}
     for key in sorted(set(s.pile_acceleration) | set(s.pile_displacement)):
         entry: dict[str, Any] = {}
         if key in s.pile_acceleration:
-            entry['vertical_acceleration_peak_m_s2'] = float(
-                np.max(np.abs(s.pile_acceleration[key].values[:, 2])))
+            az = s.pile_acceleration[key].values[:, 2]
+            entry['vertical_acceleration_peak_m_s2'] = float(np.max(np.abs(az)))
+            entry['vertical_acceleration_rms_m_s2'] = float(np.sqrt(np.mean(az ** 2)))
             rate = s.pile_rotation_rate[key]
             angle = np.cumsum(rate.values, axis=0) / rate.rate
             entry['rotation_peak_rad'] = float(np.max(np.abs(angle[:, :2])))

@@ -133,6 +133,7 @@ def soil_metrics(s: Streams) -> dict[str, Any]:
         centres, val = vibration_levels(record, fs)
         points[label.replace(' ', '_')] = {
             'vertical_acceleration_peak_m_s2': float(np.max(np.abs(record))),
+            'vertical_acceleration_rms_m_s2': float(np.sqrt(np.mean(np.square(record)))),
             'val_band_centres_hz': [float(c) for c in centres],
             'val_db': [float(v) if math.isfinite(v) else None for v in val],
             'val_max_db': float(np.max(val)), 'val_max_band_hz': float(centres[np.argmax(val)]),
