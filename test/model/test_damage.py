@@ -108,8 +108,8 @@ def test_static_midspan_deflection_of_a_damaged_span_is_virtual_work_to_1e9() ->
     """Cubic beam elements are exact at the nodes for piecewise EI on element boundaries."""
     span, ei, mass = _beam()
     zones = ((6.0, 10.0, 0.4), (14.0, 18.0, 0.3))
-    overrides = ['damage.girder=[{span: 1, position: 8, length: 4, stiffness_loss: 0.4}, '
-                 '{span: 1, position: 16, length: 4, stiffness_loss: 0.3}]']
+    overrides = ['damage.girders=[{span: 1, start: 6, length: 4, loss: 0.4}, '
+                 '{span: 1, start: 14, length: 4, loss: 0.3}]']
     computed = -_static(load_scenario(BEAM, overrides), 'midspan', -1e5)
     reference = SteppedBeam.with_zones(span, ei, mass, zones).midspan_deflection(1e5)
     assert computed == pytest.approx(reference, rel=1e-9)
@@ -120,9 +120,9 @@ def test_girder_damage_acts_on_its_span_only() -> None:
     """Span 2 damaged: span 1's elements keep their stiffness, span 2's lose it."""
     base = ['bridge.n_spans=2']
     sound = build_structure(load_scenario(BEAM, base))
-    damaged = build_structure(load_scenario(BEAM, [*base, 'damage.girder=[{span: 2, '
-                                                   'position: 16, length: 32, '
-                                                   'stiffness_loss: 0.5}]']))
+    damaged = build_structure(load_scenario(BEAM, [*base, 'damage.girders=[{span: 2, '
+                                                   'start: 0, length: 32, '
+                                                   'loss: 0.5}]']))
     d1, d2 = (s.midspan_dofs[:, 2] for s in (sound, damaged))
     k_sound, k_damaged = sound.stiffness.toarray(), damaged.stiffness.toarray()
     assert k_damaged[d2[0], d2[0]] == k_sound[d1[0], d1[0]]
@@ -253,7 +253,7 @@ def test_each_piled_pier_stands_on_its_own_damaged_ground(monkeypatch) -> None:
 # Defaults change nothing
 # --------------------------------------------------------------------------------------
 
-ZERO = ['damage.girder=[{span: 1, position: 16, length: 4, stiffness_loss: 0.0}]',
+ZERO = ['damage.girders=[{span: 1, start: 14, length: 4, loss: 0.0}]',
         'environment.temperature=20', 'train.passenger_load=0']
 ZERO_BEARINGS = ['damage.bearings=[{support: 2, stiffness_loss: 0.0}]']
 
@@ -278,7 +278,7 @@ def test_an_all_zero_damage_section_gives_bit_identical_matrices_and_frames() ->
 def test_echo_carries_the_damage_and_environment_sections() -> None:
     """summary.json names them 'damage' and 'environment'."""
     echo = load_scenario(BEAM, ZERO[:1]).echo()
-    assert echo['damage']['girder'][0]['stiffness_loss'] == 0.0
+    assert echo['damage']['girders'][0]['loss'] == 0.0
     assert echo['environment']['reference_temperature'] == 20.0
 
 
@@ -287,17 +287,17 @@ def test_echo_carries_the_damage_and_environment_sections() -> None:
 # --------------------------------------------------------------------------------------
 
 @pytest.mark.parametrize('scenario, overrides, match', [
-    (BEAM, ['damage.girder=[{span: 2, position: 16, length: 4, stiffness_loss: 0.3}]'],
-     r'damage.girder\[0\].span = 2 is not a span; allowed: 1 to 1'),
-    (BEAM, ['damage.girder=[{span: 1, position: 31, length: 4, stiffness_loss: 0.3}]'],
-     r'damage.girder\[0\]: .* off the span; allowed: inside 0 to 32 m'),
-    (BEAM, ['damage.girder=[{span: 1, position: 16, length: 4, stiffness_loss: 1.0}]'],
-     r'damage.girder\[0\].stiffness_loss = 1.* allowed \[0, 1\)'),
-    (BEAM, ['damage.girder=[{span: 1, position: 16, length: 4, stiffness_loss: -0.1}]'],
-     r'damage.girder\[0\].stiffness_loss = -0.1'),
-    (BEAM, ['damage.girder=[{span: 1, position: 16, length: 4, stiffness_loss: 0.1}, '
-            '{span: 1, position: 18, length: 4, stiffness_loss: 0.1}]'],
-     r'damage.girder\[1\] .* overlaps damage.girder\[0\]'),
+    (BEAM, ['damage.girders=[{span: 2, start: 14, length: 4, loss: 0.3}]'],
+     r'damage.girders\[0\].span = 2 is not a span; allowed: 1 to 1'),
+    (BEAM, ['damage.girders=[{span: 1, start: 29, length: 4, loss: 0.3}]'],
+     r'damage.girders\[0\]: .* off the span; allowed: inside 0 to 32 m'),
+    (BEAM, ['damage.girders=[{span: 1, start: 14, length: 4, loss: 1.0}]'],
+     r'damage.girders\[0\].loss = 1.* allowed \[0, 1\)'),
+    (BEAM, ['damage.girders=[{span: 1, start: 14, length: 4, loss: -0.1}]'],
+     r'damage.girders\[0\].loss = -0.1'),
+    (BEAM, ['damage.girders=[{span: 1, start: 14, length: 4, loss: 0.1}, '
+            '{span: 1, start: 16, length: 4, loss: 0.1}]'],
+     r'damage.girders\[1\] .* overlaps damage.girders\[0\]'),
     (BEAM, ['damage.bearings=[{support: 1, stiffness_loss: 0.5}]'],
      r"damage.bearings\[0\]: bearing damage needs bearings.model = 'elastic'"),
     (BEAM, [*ELASTIC, 'damage.bearings=[{support: 3, stiffness_loss: 0.5}]'],

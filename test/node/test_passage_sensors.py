@@ -109,22 +109,22 @@ def test_without_sensors_nothing_changes(tmp_path: Path):
 
 def test_damage_and_temperature_switch_per_passage_and_relabel(sensed):
     c = controller(sensed)
-    ok, reason = c.check_rates({'damage': '{girder: [{span: 2, position: 8, length: 2, '
-                                          'stiffness_loss: 0.3}]}'})
+    ok, reason = c.check_rates({'damage': '{girders: [{span: 2, start: 7, length: 2, '
+                                          'loss: 0.3}]}'})
     assert not ok and 'span' in reason
     ok, reason = c.check_rates({'damage': '[1, 2]'})
     assert not ok and 'expected a mapping' in reason
-    state = {'damage': '{girder: [{span: 1, position: 16, length: 4, stiffness_loss: 0.3}]}',
+    state = {'damage': '{girders: [{span: 1, start: 14, length: 4, loss: 0.3}]}',
              'environment.temperature': -10.0}
     assert c.check_rates(state) == (True, '')
     first = c.sim.structure.stiffness.copy()
     for name, value in state.items():
         c.apply(name, value)
-    assert c.sensing.labels['damage']['girder'] == []          # from the next passage
+    assert c.sensing.labels['damage']['girders'] == []          # from the next passage
     c.reset()
     tick = c.advance(budget=5.0, max_frames=5)
     assert tick.labels
-    assert c.sensing.labels['damage']['girder'][0]['stiffness_loss'] == 0.3
+    assert c.sensing.labels['damage']['girders'][0]['loss'] == 0.3
     assert c.sensing.labels['environment']['temperature'] == -10.0
     assert abs(c.sim.structure.stiffness - first).max() > 0     # the model changed
     c.close()

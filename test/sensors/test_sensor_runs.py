@@ -39,9 +39,9 @@ SPAN = {'train': {'vehicle': 'moving_force', 'speed_kmh': 200.0, 'axle_offsets':
         'solver': {'free_vibration_periods': 1.0}, 'output': {'rate_hz': 1000.0}}
 
 SENSORS = [
-    {'name': 'mid_u', 'type': 'displacement', 'at': 'girder@10.0', 'axes': 'xyz',
+    {'name': 'mid_u', 'type': 'displacement', 'at': 'girder@10.0', 'axes': ['x', 'y', 'z'],
      'rate_hz': 500.0, 'passband': 0.9},
-    {'name': 'mid_a', 'type': 'accelerometer', 'at': 'girder@10.0', 'axes': 'xz',
+    {'name': 'mid_a', 'type': 'accelerometer', 'at': 'span01/x=10.0', 'axes': ['x', 'z'],
      'rate_hz': 200.0, 'noise_density': 1e-4, 'resolution': 1e-5},
     {'name': 'sg', 'type': 'strain', 'at': 'girder@25.0', 'fibre': [0.0, -1.2],
      'rate_hz': 100.0, 'dropout_probability': 0.2, 'dropout_mean_length': 0.02},
@@ -72,11 +72,14 @@ def sensed_bag(tmp_path_factory) -> Path:
 @pytest.mark.parametrize('entry, message', [
     ({'type': 'sonar'}, r"sensors\[0\]\.type = 'sonar'"),
     ({'at': 'girder@abc'}, r"position 'abc' is not a finite number"),
-    ({'at': 'deck@3'}, r"allowed forms are 'girder@x'"),
+    ({'at': 'deck@3'}, r"allowed forms are 'spanNN/x=X'"),
     ({'type': 'strain', 'at': 'car01'}, r'a strain cannot be at .car01. \(a car\)'),
     ({'type': 'wheel_force', 'at': 'girder@3'}, r'a wheel_force cannot be at'),
     ({'rate_hz': 300.0}, r'rate_hz = 300 does not divide the frame rate 1000 Hz'),
-    ({'axes': 'zz'}, r"axes = 'zz'"),
+    ({'axes': ['z', 'z']}, r"axes = \['z', 'z'\]"),
+    ({'axes': 'z'}, r'expected a list of strings'),
+    ({'at': 'span03/x=3'}, r'span 3 does not exist; the bridge has 2'),
+    ({'at': 'span01/x=21'}, r'x = 21 m is off the span; allowed 0 to 20 m'),
     ({'relative_to': 'girder@1', 'type': 'accelerometer'}, r'relative_to is for type '),
     ({'dropout_probability': 1.0}, r'dropout_probability = 1\.0 is out of range'),
     ({'name': '9lives'}, r"name = '9lives'"),
@@ -178,12 +181,12 @@ def test_same_scenario_same_bits(tmp_path, sensed_bag):
 def test_labels_carry_the_damage_and_environment_state(tmp_path):
     out = tmp_path / 'damaged'
     assert main(['run', 'moving_force_beam', '--out', str(out), '--set',
-                 'damage.girder=[{span: 1, position: 16, length: 4, stiffness_loss: 0.3}]',
+                 'damage.girders=[{span: 1, start: 14, length: 4, loss: 0.3}]',
                  '--set', 'environment.temperature=-5', '--set',
                  'train.passenger_load=5000']) == 0
     labels = json.loads((out / 'summary.json').read_text())['labels']
-    assert labels['damage']['girder'] == [{'span': 1, 'position': 16.0, 'length': 4.0,
-                                           'stiffness_loss': 0.3}]
+    assert labels['damage']['girders'] == [{'span': 1, 'start': 14.0, 'length': 4.0,
+                                            'loss': 0.3}]
     assert labels['environment']['temperature'] == -5.0
     assert labels['train']['passenger_load'] == 5000.0
     metadata = yaml.safe_load((out / 'metadata.yaml').read_text())

@@ -68,7 +68,7 @@ def check_conditions(s: Scenario) -> None:
         return
     b = s.bridge
     try:
-        girder_bending_factors(damage.girder, b.n_spans, b.elements_per_span, b.span_length)
+        girder_bending_factors(damage.girders, b.n_spans, b.elements_per_span, b.span_length)
         bearing_stiffness_factors(damage.bearings, b.n_spans + 1,
                                   s.bearings.model == 'elastic')
         _check_piers(s)
@@ -133,10 +133,10 @@ def conditioned_bearings(s: Scenario) -> BearingParameters:
 
 def girder_bending(s: Scenario) -> np.ndarray | None:
     """Return the factor on each girder element's vertical EI, or None without girder damage."""
-    if not s.damage.girder:
+    if not s.damage.girders:
         return None
     b = s.bridge
-    return girder_bending_factors(s.damage.girder, b.n_spans, b.elements_per_span,
+    return girder_bending_factors(s.damage.girders, b.n_spans, b.elements_per_span,
                                   b.span_length)
 
 

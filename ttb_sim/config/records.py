@@ -38,7 +38,7 @@ from typing import Any
 from ttb_sim.config.observers import Observer, parse_observers
 from ttb_sim.config.schema import to_plain
 from ttb_sim.config.sensor_layouts import expand_layouts
-from ttb_sim.config.sensor_places import check_places
+from ttb_sim.config.sensor_places import check_places, on_girders
 from ttb_sim.config.sensor_records import decimation_factor, SensorConfig, SensorError
 from ttb_sim.declarations import param
 from ttb_sim.errors import ScenarioError
@@ -259,9 +259,11 @@ class Scenario:
     def all_sensors(self) -> tuple[SensorConfig, ...]:
         """The sensors of ``sensor_layouts`` (expanded), then those of ``sensors``."""
         piers = self.foundation.model in ('springs', 'piled') and self.bearings.model == 'elastic'
-        return expand_layouts(self.sensor_layouts, self.bridge.span_length,
-                              self.bridge.n_spans, piers,
-                              (self.piles.rows, self.piles.cols)) + self.sensors
+        sensors = expand_layouts(self.sensor_layouts, self.bridge.span_length,
+                                 self.bridge.n_spans, piers,
+                                 (self.piles.rows, self.piles.cols)) + self.sensors
+        return tuple(on_girders(s, self.bridge.span_length, self.bridge.n_spans)
+                     for s in sensors)
 
     def axle_positions(self) -> tuple[float, ...]:
         """Distances of all axles behind the head (m): ``train.axle_offsets`` or the car layout."""

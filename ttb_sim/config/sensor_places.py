@@ -26,13 +26,13 @@ them in frame order). Nothing here needs the model.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 import math
 from typing import Sequence
 
 from ttb_sim.config.sensor_records import LOCATION_FORMS, SensorConfig, SensorError
 
-__all__ = ['ALLOWED_PLACES', 'check_places', 'Location', 'parse_location', 'probe_requests',
+__all__ = ['ALLOWED_PLACES', 'check_places', 'on_girders', 'Location', 'parse_location', 'probe_requests',
            'ProbeRequest']
 
 AXIS = {'x': 0, 'y': 1, 'z': 2}
@@ -95,7 +95,7 @@ def parse_location(text: str, what: str) -> Location:
         match = form.match(text.strip())
         if match:
             location = Location(kind, match.groups())
-            if kind == 'line':
+            if kind in ('line', 'span'):
                 try:
                     x = float(location.parts[1])
                 except ValueError:
@@ -104,9 +104,42 @@ def parse_location(text: str, what: str) -> Location:
                     raise SensorError(f'{what} = {text!r}: position {location.parts[1]!r} is '
                                       'not a finite number (m)')
             return location
-    raise SensorError(f"{what} = {text!r}: allowed forms are 'girder@x' (or rail_left, "
+    raise SensorError(f"{what} = {text!r}: allowed forms are 'spanNN/x=X' (X m from the "
+                      "span's left support), 'girder@x' (x along the track; or rail_left, "
                       "rail_right, slab, base), 'carNN', 'carNN/axleK/left|right', "
                       "'pierNN/pileMM', 'pierNN/top', 'ground/pierNN/<point>'")
+
+
+def on_girders(config: SensorConfig, span_length: float, n_spans: int) -> SensorConfig:
+    """
+    Return the sensor with ``spanNN/x=X`` places written as girder points ``girder@x``.
+
+    Span NN runs from (NN - 1) L to NN L along the track; a point at its right support
+    (X = L) is put a micrometre inside, on this girder rather than the next.
+
+    Raises
+    ------
+    SensorError
+        For a span that does not exist or an X off the span.
+    """
+    changes = {}
+    for key in ('at', 'relative_to'):
+        text = getattr(config, key)
+        if not text:
+            continue
+        location = parse_location(text, f'{config.name}: {key}')
+        if location.kind != 'span':
+            continue
+        span, x = int(location.parts[0]), location.x
+        if not 1 <= span <= n_spans:
+            raise SensorError(f'{config.name}: {key} = {text!r}: span {span} does not exist; '
+                              f'the bridge has {n_spans} (1 to {n_spans})')
+        if not 0.0 <= x <= span_length:
+            raise SensorError(f'{config.name}: {key} = {text!r}: x = {x:g} m is off the span; '
+                              f'allowed 0 to {span_length:g} m (bridge.span_length)')
+        track_x = (span - 1) * span_length + min(x, span_length - 1e-6)
+        changes[key] = f'girder@{track_x:.9g}'
+    return replace(config, **changes) if changes else config
 
 
 def check_places(config: SensorConfig) -> None:

@@ -51,13 +51,15 @@ about the axis; strain: the one fibre strain, along x)."""
 
 LOCATION_FORMS = {
     'line': re.compile(r'^(girder|rail_left|rail_right|slab|base)@(.+)$'),
+    'span': re.compile(r'^span(\d+)/x=(.+)$'),
     'car': re.compile(r'^car(\d+)$'),
     'wheel': re.compile(r'^car(\d+)/axle(\d+)/(left|right)$'),
     'pile': re.compile(r'^pier(\d+)/pile(\d+)$'),
     'pier_top': re.compile(r'^pier(\d+)/top$'),
     'ground': re.compile(r'^ground/pier(\d+)/([A-Za-z0-9_]+)$'),
 }
-"""The forms of ``at``: a point of a beam line at track position x (``girder@208.0``,
+"""The forms of ``at``: a point of girder NN at x m from its left support (``span07/x=16.0``),
+a point of a beam line at track position x (``girder@208.0``,
 ``rail_left@x``, ``slab@x``, ``base@x``), a car body (``car03``), a wheel
 (``car03/axle2/left``), a pile head (``pier07/pile05``), a pier top (``pier07/top``) and
 a ground point of a piled pier by its name in ``summary.json`` (``ground/pier07/line_01``)."""
@@ -91,9 +93,10 @@ class SensorConfig:
                     "'ground/pierNN/<point>' (a ground point by its summary.json name).")
     relative_to: str = param('', '-', "displacement: a second point in the forms of 'at'; "
                              'the sensor reads at minus relative_to.')
-    axes: str = param('', '-', "Axes measured, a subset of 'xyz' in track axes (x along the "
-                      "track, y left, z up); '' = the type's default (z; inclinometer y, the "
-                      'rotation of bending; strain x; wheel_force xyz).')
+    axes: tuple[str, ...] = param((), '-', "Axes measured, a list of x, y, z in track axes "
+                                  '(x along the track, y left, z up), e.g. [z] or [x, z]; '
+                                  "[] = the type's default (z; inclinometer y, the rotation of "
+                                  'bending; strain x; wheel_force x, y, z).')
     fibre: tuple[float, ...] = param((0.0, 0.0), 'm', 'strain: the fibre [y, z] from the beam '
                                      'axis (z < 0 below it: a gauge on the soffit).',
                                      low=-100.0, high=100.0)
@@ -137,12 +140,13 @@ class SensorConfig:
             raise SensorError(f'{self.name}: at is empty; allowed forms: girder@x, carNN, '
                               'carNN/axleK/left|right, pierNN/pileMM, pierNN/top, '
                               'ground/pierNN/<point>')
-        if self.axes and not _AXES.match(self.axes):
-            raise SensorError(f'{self.name}: axes = {self.axes!r}; allowed: one to three of '
+        joined = ''.join(self.axes)
+        if joined and not _AXES.match(joined):
+            raise SensorError(f'{self.name}: axes = {list(self.axes)!r}; allowed: one to three of '
                               'x, y, z, each once')
-        if self.type == 'strain' and self.axes not in ('', 'x'):
-            raise SensorError(f'{self.name}: axes = {self.axes!r}; a strain gauge measures the '
-                              "fibre strain along the beam only (axes 'x' or '')")
+        if self.type == 'strain' and joined not in ('', 'x'):
+            raise SensorError(f'{self.name}: axes = {list(self.axes)!r}; a strain gauge '
+                              'measures the fibre strain along the beam only (axes [x] or [])')
         if len(self.fibre) != 2:
             raise SensorError(f'{self.name}: fibre = {list(self.fibre)!r}; expected [y, z] (m)')
         if self.relative_to and self.type != 'displacement':
@@ -152,7 +156,7 @@ class SensorConfig:
     @property
     def measured_axes(self) -> str:
         """Return the axes measured (``axes`` or the type's default)."""
-        return self.axes or DEFAULT_AXES[self.type]
+        return ''.join(self.axes) or DEFAULT_AXES[self.type]
 
     @property
     def unit(self) -> str:

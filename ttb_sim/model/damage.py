@@ -17,7 +17,7 @@ Damage: the scenario section ``damage`` and the stiffness it takes from the mode
 
 Four physical models (docs/damage.md gives their sources and limits):
 
-- ``damage.girder``: a cracked zone of a girder, the vertical bending stiffness EI
+- ``damage.girders``: a cracked zone of a girder, the vertical bending stiffness EI
   times (1 - loss) over a length at a position of a span. A girder element the zone
   covers in part gets the flexibility average of its cracked and sound parts
   (:func:`girder_bending_factors`), exact for a uniform bending moment over the element.
@@ -60,31 +60,25 @@ class DamageError(ModelError):
 
 @dataclass(frozen=True)
 class GirderDamage:
-    """A zone of lost vertical bending stiffness on one span (an entry of ``damage.girder``)."""
+    """A zone of lost vertical bending stiffness on one span (an entry of ``damage.girders``)."""
 
     span: int = param(1, '-', 'Span, 1-based (1 = the first span).', low=1, high=50)
-    position: float = param(16.0, 'm', "Centre of the damaged zone from the span's start.",
-                            low=0.0, high=500.0)
+    start: float = param(15.0, 'm', "Start of the damaged zone, from the span's left "
+                         'support.', low=0.0, high=500.0)
     length: float = param(2.0, 'm', 'Length of the damaged zone along the span.', low=0.0,
                           high=500.0, low_inclusive=False)
-    stiffness_loss: float = param(0.0, '-', 'Fraction of the vertical bending stiffness EI '
-                                  'lost in the zone (lateral bending, torsion and axial '
-                                  'stiffness are kept).', low=0.0, high=1.0,
-                                  high_inclusive=False)
+    loss: float = param(0.0, '-', 'Fraction of the vertical bending stiffness EI lost in the '
+                        'zone (lateral bending, torsion and axial stiffness are kept).',
+                        low=0.0, high=1.0, high_inclusive=False)
 
     def __post_init__(self) -> None:
         """Check every field against its declaration."""
-        check_declared(self, 'damage.girder.', DamageError)
-
-    @property
-    def start(self) -> float:
-        """Return the distance (m) from the span's first end to the zone's."""
-        return self.position - 0.5 * self.length
+        check_declared(self, 'damage.girders.', DamageError)
 
     @property
     def end(self) -> float:
-        """Return the distance (m) from the span's first end to the zone's far end."""
-        return self.position + 0.5 * self.length
+        """Return the distance (m) from the span's left support to the zone's far end."""
+        return self.start + self.length
 
 
 @dataclass(frozen=True)
@@ -139,9 +133,10 @@ class Scour:
 class DamageParameters:
     """Damage of girders, bearings, piles and the ground around piled piers (``damage``)."""
 
-    girder: tuple[GirderDamage, ...] = param(
-        (), '-', 'Cracked girder zones, each {span, position, length, stiffness_loss}; '
-        'vertical bending EI times (1 - stiffness_loss) over the zone (docs/damage.md).')
+    girders: tuple[GirderDamage, ...] = param(
+        (), '-', 'Cracked girder zones, each {span, start, length, loss}: vertical bending EI '
+        "times (1 - loss) from start (m from the span's left support) over length "
+        '(docs/damage.md).')
     bearings: tuple[BearingDamage, ...] = param(
         (), '-', 'Degraded bearings, each {support, side, stiffness_loss} '
         "(needs bearings.model = 'elastic').")
@@ -155,7 +150,7 @@ class DamageParameters:
     @property
     def given(self) -> bool:
         """Tell whether some damage entry is given, even one with a zero loss."""
-        return bool(self.girder or self.bearings or self.piles or self.scour)
+        return bool(self.girders or self.bearings or self.piles or self.scour)
 
 
 def girder_bending_factors(zones: Sequence[GirderDamage], n_spans: int,
@@ -183,20 +178,19 @@ def girder_bending_factors(zones: Sequence[GirderDamage], n_spans: int,
         _check_zone(i, zone, n_spans, span_length)
         covered = np.clip(np.minimum(zone.end, edges[1:]) - np.maximum(zone.start, edges[:-1]),
                           0.0, None) / h
-        flexibility[zone.span - 1] += covered * (zone.stiffness_loss
-                                                 / (1.0 - zone.stiffness_loss))
+        flexibility[zone.span - 1] += covered * (zone.loss / (1.0 - zone.loss))
     _check_overlaps(zones)
     return (1.0 / flexibility).ravel()
 
 
 def _check_zone(i: int, zone: GirderDamage, n_spans: int, span_length: float) -> None:
-    where = f'damage.girder[{i}]'
+    where = f'damage.girders[{i}]'
     if zone.span > n_spans:
         raise DamageError(f'{where}.span = {zone.span} is not a span; allowed: 1 to '
                           f'{n_spans} (bridge.n_spans)')
     if zone.start < 0.0 or zone.end > span_length:
-        raise DamageError(f'{where}: the zone position = {zone.position:g} m +/- length / 2 = '
-                          f'{0.5 * zone.length:g} m runs from {zone.start:g} to {zone.end:g} m, '
+        raise DamageError(f'{where}: the zone start = {zone.start:g} m + length = '
+                          f'{zone.length:g} m runs from {zone.start:g} to {zone.end:g} m, '
                           f'off the span; allowed: inside 0 to {span_length:g} m '
                           '(bridge.span_length)')
 
@@ -205,8 +199,8 @@ def _check_overlaps(zones: Sequence[GirderDamage]) -> None:
     for i, a in enumerate(zones):
         for j, b in enumerate(zones[:i]):
             if a.span == b.span and a.start < b.end and b.start < a.end:
-                raise DamageError(f'damage.girder[{i}] ({a.start:g} to {a.end:g} m) overlaps '
-                                  f'damage.girder[{j}] ({b.start:g} to {b.end:g} m) on span '
+                raise DamageError(f'damage.girders[{i}] ({a.start:g} to {a.end:g} m) overlaps '
+                                  f'damage.girders[{j}] ({b.start:g} to {b.end:g} m) on span '
                                   f'{a.span}; give one zone with the combined loss')
 
 

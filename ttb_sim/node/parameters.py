@@ -168,8 +168,8 @@ _NODE_ONLY: dict[str, tuple[str, Any, Spec, bool]] = {
     'bag.storage': ('string', 'mcap', Spec(
         '-', 'rosbag2 storage plugin.', choices=tuple(STORAGES)), True),
     DAMAGE_PARAMETER: ('string', '', Spec(
-        '-', "The damage section as YAML, e.g. '{girder: [{span: 7, position: 16, length: 4, "
-        "stiffness_loss: 0.3}]}' (docs/damage.md); '' = the scenario's own. The labels and "
+        '-', "The damage section as YAML, e.g. '{girders: [{span: 7, start: 14, length: 4, "
+        "loss: 0.3}]}' (docs/damage.md); '' = the scenario's own. The labels and "
         'the bag show the switch.'), False),
 }
 
@@ -423,6 +423,5 @@ def damage_section(text: str) -> Any:
                             f'({" ".join(str(exc).split())[:200]})') from None
     if not isinstance(data, dict):
         raise ScenarioError(f'{DAMAGE_PARAMETER} = {shown(text)}: expected a mapping such as '
-                            "'{girder: [{span: 7, position: 16, length: 4, stiffness_loss: "
-                            "0.3}]}'")
+                            "'{girders: [{span: 7, start: 14, length: 4, loss: 0.3}]}'")
     return data

@@ -15,7 +15,7 @@
 """
 V23: the first bending frequency of a span with a stiffness loss over a segment.
 
-The pipeline (``moving_force_beam`` with a ``damage.girder`` entry -> the assembled
+The pipeline (``moving_force_beam`` with a ``damage.girders`` entry -> the assembled
 structure -> its natural modes, as ``ttb-sim modes`` finds them) against the exact
 frequency of the stepped Euler-Bernoulli beam
 (:class:`~ttb_sim.validation.references.stepped_beam.SteppedBeam`, transfer matrices).
@@ -66,8 +66,8 @@ def first_bending_frequency(overrides: Sequence[str] = ()) -> float:
 
 def girder_damage(position: float, length: float, loss: float) -> str:
     """Return the ``--set`` override of one damaged zone on span 1."""
-    return (f'damage.girder=[{{span: 1, position: {position!r}, length: {length!r}, '
-            f'stiffness_loss: {loss!r}}}]')
+    return (f'damage.girders=[{{span: 1, start: {position - 0.5 * length!r}, '
+            f'length: {length!r}, loss: {loss!r}}}]')
 
 
 def v23_rows() -> list[Row]:

@@ -68,7 +68,7 @@ QUIET_SCENARIO = {
     'bearings': {'model': 'rigid'}, 'foundation': {'model': 'rigid'},
     'solver': {'duration': 5.0}, 'output': {'rate_hz': FRAME_RATE},
     'sensors': [{'name': 'deck_z', 'type': 'accelerometer', 'at': 'girder@16.0',
-                 'axes': 'z', 'rate_hz': SENSOR_RATE, 'noise_density': NOISE_DENSITY}]}
+                 'axes': ['z'], 'rate_hz': SENSOR_RATE, 'noise_density': NOISE_DENSITY}]}
 
 
 def noise_density_row() -> Row:
