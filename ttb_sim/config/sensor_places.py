@@ -28,12 +28,12 @@ from __future__ import annotations
 
 from dataclasses import dataclass, replace
 import math
-from typing import Sequence
+from typing import Any, Sequence
 
 from ttb_sim.config.sensor_records import LOCATION_FORMS, SensorConfig, SensorError
 
-__all__ = ['ALLOWED_PLACES', 'check_places', 'on_girders', 'Location', 'parse_location', 'probe_requests',
-           'ProbeRequest']
+__all__ = ['ALLOWED_PLACES', 'check_places', 'Location', 'on_girders', 'parse_location',
+           'probe_requests', 'ProbeRequest']
 
 AXIS = {'x': 0, 'y': 1, 'z': 2}
 
@@ -122,7 +122,7 @@ def on_girders(config: SensorConfig, span_length: float, n_spans: int) -> Sensor
     SensorError
         For a span that does not exist or an X off the span.
     """
-    changes = {}
+    changes: dict[str, Any] = {}
     for key in ('at', 'relative_to'):
         text = getattr(config, key)
         if not text:

@@ -93,7 +93,7 @@ class SensorConfig:
                     "'ground/pierNN/<point>' (a ground point by its summary.json name).")
     relative_to: str = param('', '-', "displacement: a second point in the forms of 'at'; "
                              'the sensor reads at minus relative_to.')
-    axes: tuple[str, ...] = param((), '-', "Axes measured, a list of x, y, z in track axes "
+    axes: tuple[str, ...] = param((), '-', 'Axes measured, a list of x, y, z in track axes '
                                   '(x along the track, y left, z up), e.g. [z] or [x, z]; '
                                   "[] = the type's default (z; inclinometer y, the rotation of "
                                   'bending; strain x; wheel_force x, y, z).')
