@@ -121,6 +121,7 @@ def on_girders(config: SensorConfig, span_length: float, n_spans: int) -> Sensor
     ------
     SensorError
         For a span that does not exist or an X off the span.
+
     """
     changes: dict[str, Any] = {}
     for key in ('at', 'relative_to'):
