@@ -43,7 +43,7 @@ from typing import Any, Callable, Iterator, Mapping
 
 from ttb_sim.config import Scenario
 from ttb_sim.errors import DivergenceError, ScenarioError, TtbSimError
-from ttb_sim.io.sensor_stream import MessageSink, SensorSample, SensorStream
+from ttb_sim.io.sensor_stream import SensorSample, SensorStream
 from ttb_sim.io.topics import topic_table
 from ttb_sim.node.diagnostics import (DiagnosticsReport, frame_values, passage_level,
                                       SlidingWindow, StepMeter)
@@ -53,6 +53,7 @@ from ttb_sim.node.parameters import (DAMAGE_PARAMETER, IRREGULARITY_KEYS, normal
 from ttb_sim.node.rates import (check_rate, FAMILIES, family_of, family_periods, frame_stride,
                                 RATE_PARAMETERS, Schedule)
 from ttb_sim.node.runs import FrameSink, TrainRun
+from ttb_sim.node.sensing import LiveSensing
 from ttb_sim.sim import Frame, Layout, make_runner, Runner
 
 __all__ = ['PassageController', 'Tick']
@@ -164,10 +165,7 @@ class PassageController:
         self.simulated = 0.0
         """Simulated seconds stepped over the node's life (all passages)."""
         self._base_every = 1
-        self.sensing: SensorStream | None = None
-        """The virtual sensors and the labels (built with the first passage)."""
-        self._sensing_rate = 0.0
-        self._labels_due = False
+        self._sensing = LiveSensing()
         self._start_passage()
         ok, reason = self.check_rates(self.values)
         if not ok:
@@ -195,7 +193,7 @@ class PassageController:
             if name == 'train.speed_kmh':
                 if self._train is not None:
                     self._train.set_speed(value / 3.6)
-                    self._relabel(self.passage_scenario())
+                    self._sensing.relabel(self.passage_scenario())
                 else:
                     log.info('train.speed_kmh has no effect on a substructure run')
             elif name == 'real_time_factor':   # the new pace counts from now
@@ -327,7 +325,8 @@ class PassageController:
                 tick.sleep = 0.1
                 return tick
             self._set_frame_stride()
-            self._emit_labels(tick)
+            tick.labels = self._sensing.emit_labels(self.recorder, round(self._node_time * 1e9),
+                                                    self._recording_failed)
             now = self._clock()
             if self._run_started is None:
                 self._run_started = now
@@ -384,10 +383,9 @@ class PassageController:
         self._meter.frame(self.sim.output_every, self.frame_period if raw.step else 0.0)
         self.simulated += self.frame_period if raw.step else 0.0
         self._record(frame)
-        if self.sensing is not None:
-            samples = self.sensing.push(frame)
-            tick.samples.extend(samples)
-            self._record_samples(samples)
+        samples = self._sensing.push(frame)
+        tick.samples.extend(samples)
+        self._sensing.record(self.recorder, samples, self._recording_failed)
         due = self._schedule.due(frame.time, self.publish_periods())
         if due:
             tick.frames.append(frame)
@@ -409,7 +407,7 @@ class PassageController:
         if sim is None:
             return
         stride = 1
-        sensors = self.sensing is not None and self.sensing.samples_every_frame
+        sensors = self._sensing.samples_every_frame
         if self.recorder is None and not sensors:
             stride = frame_stride(self.publish_periods(), self.output_period)
         sim.output_every = self._base_every * stride
@@ -480,7 +478,7 @@ class PassageController:
             present = {family_of(t.name) for t in topic_table(self.sim.layout)}
             self._families = tuple(f for f in FAMILIES if f in present) or ('',)
             self._schedule = Schedule(self._families, self.time_offset)
-        self._start_sensing(scenario)
+        self._sensing.start(scenario, self.sim.layout, self.sim.dt, self._base_every)
         self._frames = self.sim.frames()
         self._exit_time = None
         self.passage += 1
@@ -496,56 +494,17 @@ class PassageController:
 
     # -- sensors and labels -------------------------------------------------------------
 
-    def _start_sensing(self, scenario: Scenario) -> None:
-        """Build the sensors with the first passage (again if the frame rate changed)."""
-        rate = 1.0 / (self.sim.dt * self._base_every)
-        if self.sensing is None or abs(self._sensing_rate - rate) > 1e-9 * rate:
-            if self.sensing is not None:
-                log.info('the frame rate changed to %g Hz: the sensors start afresh', rate)
-            self.sensing = SensorStream(scenario, self.sim.layout, self.sim.dt,
-                                        self._base_every)
-            self._sensing_rate = rate
-        self._relabel(scenario)
-
-    def _relabel(self, scenario: Scenario) -> None:
-        """Take the labels of the passage now; publish and record them from the next tick."""
-        if self.sensing is None:
-            return
-        self.sensing.relabel(scenario)
-        self._labels_due = True
-
-    def _emit_labels(self, tick: Tick) -> None:
-        """Hand changed labels to the tick (to publish) and to the recorder."""
-        if not self._labels_due or self.sensing is None:
-            return
-        self._labels_due = False
-        tick.labels = True
-        sink = self.recorder
-        if self.sensing.takes(sink):
-            assert isinstance(sink, MessageSink)
-            try:
-                self.sensing.write_labels(sink, round(self._node_time * 1e9))
-            except Exception as exc:  # noqa: B902 - any writer failure stops recording only
-                self._recording_failed(exc)
-
-    def _record_samples(self, samples: list[SensorSample]) -> None:
-        sink = self.recorder
-        assert self.sensing is not None
-        if not samples or not self.sensing.takes(sink):
-            return
-        assert isinstance(sink, MessageSink)
-        try:
-            self.sensing.write(sink, samples)
-        except Exception as exc:  # noqa: B902 - any writer failure stops recording only
-            self._recording_failed(exc)
+    @property
+    def sensing(self) -> SensorStream | None:
+        """The virtual sensors and the labels (None until the first passage starts)."""
+        return self._sensing.stream
 
     def _flush_sensors(self, tick: Tick | None = None) -> None:
         """Record (and hand to the tick) the samples of the frames the sensors still keep."""
-        if self.sensing is not None:
-            samples = self.sensing.flush()
-            if tick is not None:
-                tick.samples.extend(samples)
-            self._record_samples(samples)
+        samples = self._sensing.flush()
+        if tick is not None:
+            tick.samples.extend(samples)
+        self._sensing.record(self.recorder, samples, self._recording_failed)
 
     # -- recording ----------------------------------------------------------------------
 

@@ -32,6 +32,7 @@ from ttb_sim.config import load_scenario, Scenario
 from ttb_sim.sim import Newmark, Simulation
 from ttb_sim.validation.cases.analysis import ANALYSIS_CASES
 from ttb_sim.validation.cases.components import COMPONENT_CASES
+from ttb_sim.validation.cases.conditions import CONDITION_CASES
 from ttb_sim.validation.cases.coupled import COUPLED_CASES
 from ttb_sim.validation.cases.damage import DAMAGE_CASES
 from ttb_sim.validation.cases.pile_group import PILE_GROUP_CASES
@@ -171,7 +172,8 @@ CASES: dict[str, Case] = {c.case_id: c for c in sorted((
     Case('V3', 'sprung mass crossing a simply supported beam (Yang & Yau)', _v3),
     Case('V7', 'Newmark average acceleration: order and energy', _v7),
     *COMPONENT_CASES, *SLAB_PLATE_CASES, *SYSTEM_CASES, *TRACK_CASES, *PILE_SOIL_CASES,
-    *PILE_GROUP_CASES, *ANALYSIS_CASES, *COUPLED_CASES, *DAMAGE_CASES, *SENSOR_CASES),
+    *PILE_GROUP_CASES, *ANALYSIS_CASES, *COUPLED_CASES, *DAMAGE_CASES, *SENSOR_CASES,
+    *CONDITION_CASES),
     key=lambda c: (c.case_id[0] != 'V', int(c.case_id[1:])))}
 """Cases by id: V* are VALIDATION.md's, X* are extra checks of modelling choices."""
 

@@ -134,11 +134,13 @@ class _Tables:
     beta: np.ndarray
 
 
-def _tables(spec: Substructure) -> _Tables:
+def _tables(spec: Substructure, residual: float) -> _Tables:
     layers, piles = spec.soil.layers, spec.piles
     rows = [(lay.E, lay.nu, lay.rho, lay.damping_ratio) for lay in layers]
-    if piles is not None:
-        rows.append((piles.E, piles.nu, piles.rho, piles.damping_ratio))
+    rows.append((piles.E, piles.nu, piles.rho, piles.damping_ratio) if piles is not None
+                else (0.0, 0.0, 0.0, 0.0))
+    rows += [(lay.E * residual, lay.nu, lay.rho * residual, lay.damping_ratio)
+             for lay in layers]
     young, poisson, density, zeta = (np.array(c, dtype=float) for c in zip(*rows))
     w1, w2 = (2.0 * math.pi * f for f in spec.rayleigh_frequencies)
     return _Tables(young, poisson, density, 2.0 * zeta * w1 * w2 / (w1 + w2),
@@ -166,10 +168,17 @@ class IndependentBlock:
         Node coordinates (m).
     cells : array of int, shape (m, 8)
         Cell corners, any order within each cell.
+    removed_above : float
+        Depth (m) above which the soil is removed (scour): a soil cell whose
+        centroid lies above it, and the outer faces above it, take ``residual``
+        times the modulus and density of their layer. 0 removes nothing.
+    residual : float
+        Fraction of modulus and density left in removed soil.
 
     """
 
-    def __init__(self, spec: Substructure, nodes: np.ndarray, cells: np.ndarray) -> None:
+    def __init__(self, spec: Substructure, nodes: np.ndarray, cells: np.ndarray,
+                 removed_above: float = 0.0, residual: float = 1e-6) -> None:
         from skfem import Basis, ElementHex1, ElementVector, MeshHex1  # noqa: I202
 
         if spec.cap.enabled:
@@ -182,8 +191,12 @@ class IndependentBlock:
                              np.ascontiguousarray(skfem_cells(nodes, cells)))
         self.element = ElementVector(ElementHex1())
         centroids = self.mesh.p[:, self.mesh.t].mean(axis=1).T
-        self.material = cell_materials(spec, centroids)
-        self.tables = _tables(spec)
+        material = cell_materials(spec, centroids)
+        n_layers = len(spec.soil.layers)
+        removed = (material < n_layers) & (centroids[:, 2] > -removed_above)
+        self.material = np.where(removed, material + n_layers + 1, material)
+        self.removed_above, self.residual = float(removed_above), float(residual)
+        self.tables = _tables(spec, residual)
         # the whole-mesh basis numbers the DOFs and interpolates (probes): one point per
         # cell is enough for that and keeps its memory at 1/8 of an integrating one
         self.basis = Basis(self.mesh, self.element, intorder=1)
@@ -272,12 +285,15 @@ class IndependentBlock:
         layer = np.clip(np.searchsorted(-tops[1:], -centre[:, 2], side='right'), 0,
                         len(layers) - 1)
         distance = np.linalg.norm(centre - source, axis=1)
+        kept = np.where(centre[:, 2] > -self.removed_above, self.residual, 1.0)
+        g, rho = g[layer] * kept, rho[layer] * kept
+        vs, vp = vs[layer], vp[layer]
         springs = soil.boundary in ('viscoelastic', 'rigid_base')
         fb = FacetBasis(self.mesh, self.element, facets=facets, intorder=3)
         per_facet = {
-            'kn': soil.alpha_n * g[layer] / distance if springs else 0.0 * distance,
-            'kt': soil.alpha_t * g[layer] / distance if springs else 0.0 * distance,
-            'cn': rho[layer] * vp[layer], 'ct': rho[layer] * vs[layer]}
+            'kn': soil.alpha_n * g / distance if springs else 0.0 * distance,
+            'kt': soil.alpha_t * g / distance if springs else 0.0 * distance,
+            'cn': rho * vp, 'ct': rho * vs}
         fields = {k: np.repeat(v[:, None], fb.X.shape[1], axis=1) for k, v in per_facet.items()}
 
         @BilinearForm

@@ -84,6 +84,30 @@ def layered_pile_stiffness(thicknesses: Sequence[float], shear_moduli: Sequence[
     return randolph_wroth_stiffness(g_tip, nu, length, 0.5 * diameter, pile_modulus, rho, 1.0)
 
 
+def scoured_pile_stiffness(thicknesses: Sequence[float], shear_moduli: Sequence[float],
+                           nu: float, length: float, diameter: float, pile_modulus: float,
+                           area: float, depth: float) -> float:
+    """
+    Return the axial head stiffness of a pile whose top ``depth`` of soil is removed (N/m).
+
+    The free length above the scour line in series with Randolph-Wroth
+    (:func:`layered_pile_stiffness`) for the embedded rest, in the layers below
+    the scour line (the one it cuts shortened): 1 / (depth / (E_p A) + 1 / K_RW).
+    """
+    kept_thickness: list[float] = []
+    kept_modulus: list[float] = []
+    top = 0.0
+    for t, g in zip(thicknesses, shear_moduli):
+        bottom = top + t
+        if bottom > depth:
+            kept_thickness.append(bottom - max(top, depth))
+            kept_modulus.append(g)
+        top = bottom
+    embedded = layered_pile_stiffness(kept_thickness, kept_modulus, nu, length - depth,
+                                      diameter, pile_modulus)
+    return 1.0 / (depth / (pile_modulus * area) + 1.0 / embedded)
+
+
 def gazetas_stiffness(young: float, diameter: float, length: float) -> float:
     """Return Gazetas' (1991) floating-pile fit K = 1.9 E d (L/d)^(2/3) (N/m)."""
     return 1.9 * young * diameter * (length / diameter)**(2.0 / 3.0)
