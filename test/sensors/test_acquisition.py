@@ -114,6 +114,18 @@ def test_clock_offset_shifts_the_stamps_and_drops_the_negative_ones():
     assert late[0] == 2_700_000 and dropped == 3
 
 
+def test_clock_drift_stretches_the_stamps_by_its_ppm():
+    """100 ppm: 5 ms samples stamped 5.0005 ms apart; the samples themselves are unchanged."""
+    rng = np.random.default_rng(5)
+    truth = rng.normal(size=(4000, 1))
+    stamps, values, _ = through(sensor(clock_drift=100.0, clock_offset=0.001), truth, 333)
+    plain_stamps, plain_values, _ = through(sensor(), truth, 333)
+    assert np.array_equal(values, plain_values)
+    assert np.all(np.abs(np.diff(stamps) - 5_000_500) <= 1)
+    expected = np.round(plain_stamps * (1 + 1e-4) + 1_000_000).astype(np.int64)
+    assert np.all(np.abs(stamps - expected) <= 1)
+
+
 def test_dropouts_lose_the_fraction_asked_in_runs_of_the_mean_length():
     p, mean = 0.25, 0.05
     stamps, _, dropped = through(sensor(dropout_probability=p, dropout_mean_length=mean),

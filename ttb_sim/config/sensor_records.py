@@ -127,6 +127,9 @@ class SensorConfig:
     clock_offset: float = param(0.0, 's', "Offset of the sensor's clock: its stamps are the "
                                 'true sample times plus this (samples stamped before 0 are '
                                 'not published).', low=-10.0, high=10.0)
+    clock_drift: float = param(0.0, 'ppm', "Rate error of the sensor's clock: its stamps are "
+                               'the true sample times times (1 + clock_drift * 1e-6), plus '
+                               'clock_offset (a crystal: 1-50 ppm).', low=-1e4, high=1e4)
     seed: int = param(-1, '-', "Seed of the sensor's noise and dropouts, independent of "
                       'irregularity.seed; -1 = derived from the name.', low=-1, high=2**63 - 1)
 

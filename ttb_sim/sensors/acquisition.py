@@ -167,7 +167,8 @@ class Acquisition:
         if cfg.full_scale > 0.0:
             clipped = np.any(np.abs(values) > cfg.full_scale, axis=1)
             values = np.clip(values, -cfg.full_scale, cfg.full_scale)
-        stamps = np.round((np.asarray(times)[picked] + cfg.clock_offset) * 1e9).astype(np.int64)
+        clock = np.asarray(times)[picked] * (1.0 + 1e-6 * cfg.clock_drift) + cfg.clock_offset
+        stamps = np.round(clock * 1e9).astype(np.int64)
         kept = self._kept(len(picked)) & (stamps >= 0)
         return Samples(stamps_ns=stamps[kept], values=values[kept],
                        dropped=int(np.count_nonzero(~kept)),

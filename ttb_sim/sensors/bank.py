@@ -81,7 +81,8 @@ class SensorChannel:
                 'noise_std': acq.sigma, 'noise_density': c.noise_density, 'bias': c.bias,
                 'bias_walk': c.bias_walk, 'resolution': c.resolution,
                 'full_scale': c.full_scale, 'dropout_probability': c.dropout_probability,
-                'clock_offset': c.clock_offset, 'samples_published': self.published,
+                'clock_offset': c.clock_offset,
+                'clock_drift_ppm': c.clock_drift, 'samples_published': self.published,
                 'samples_dropped': self.dropped, 'samples_clipped': self.clipped}
 
 
