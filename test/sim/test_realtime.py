@@ -30,7 +30,7 @@ import numpy as np
 import pytest
 
 from ttb_sim.config import load_scenario
-from ttb_sim.errors import DivergenceError, ScenarioError
+from ttb_sim.errors import DivergenceError
 from ttb_sim.sim import kernel_registry, Simulation
 
 FIELDS = ('midspan', 'bearings', 'body_acceleration', 'wheel_rail', 'observers', 'speed',
@@ -139,12 +139,3 @@ def test_without_numba_realtime_steps_one_by_one_with_the_same_results(monkeypat
     for a, b in zip(plain, fast):
         # numpy twins against the compiled kernels: equal to round-off (test_kernels.py).
         np.testing.assert_allclose(a.midspan, b.midspan, rtol=1e-12, atol=1e-18)
-
-
-def test_multibody_cars_are_refused_with_what_is_allowed():
-    with pytest.raises(ScenarioError) as caught:
-        load_scenario('paper_ttbi', values=[('solver.variant', 'realtime')])
-    message = str(caught.value)
-    assert "solver.variant = 'realtime'" in message
-    assert "train.vehicle = 'car'" in message
-    assert "'reduced'" in message

@@ -151,7 +151,9 @@ class SolverConfig:
                          '(opt-in) is qdldl with the slab track detailed only in a window '
                          "around the train, the far track condensed onto the bridge. 'realtime' "
                          'is qdldl with the steps between frames in one compiled loop, one '
-                         'thread (moving forces and quarter cars; docs/performance.md).',
+                         'thread (moving forces and quarter cars); with multibody cars the '
+                         'rails at dt and the structure under them at rail_steps * dt '
+                         '(multi-rate; docs/performance.md).',
                          choices=('qdldl', 'cholmod', 'superlu_sym', 'reference', 'reduced',
                                   'realtime'))
     substructure_steps: int = param(3, '-', 'Piled foundations: solver steps per substructure '
@@ -168,6 +170,11 @@ class SolverConfig:
                          'two when the 1-minute load average leaves at least 1.5 cores free, '
                          'else one (two threads on a busy machine wait for each other). The '
                          'results are the same bits with any count.', low=0, high=64)
+    rail_steps: int = param(5, '-', "solver.variant 'realtime' with multibody cars: rail "
+                            'steps (dt) per step of the structure under the rails (slabs, '
+                            'base plates, girders, piers), which advances at rail_steps * dt '
+                            '(docs/performance.md); 1 = both at dt, still staggered.', low=1,
+                            high=50)
     window_margin: float = param(30.0, 'm', "solver.variant 'reduced': detailed track kept "
                                  'behind the last axle and ahead of the first; more keeps '
                                  "more of the track's waves at more cost "
@@ -321,11 +328,6 @@ def _check_consistency(s: Scenario) -> None:
     if s.track.model == 'slab' and s.train.vehicle != 'car':
         raise ScenarioError(f"track.model = 'slab' needs train.vehicle = 'car' (got "
                             f'{s.train.vehicle!r})')
-    if s.solver.variant == 'realtime' and s.train.vehicle == 'car':
-        raise ScenarioError("solver.variant = 'realtime' does not apply to train.vehicle = "
-                            "'car' yet (multibody cars on the slab track, issue #27); allowed "
-                            "for them: 'reduced' (the fastest), 'qdldl', 'cholmod', "
-                            "'superlu_sym', 'reference'")
     _check_model_size(s)
     _check_track_fit(s)
     _check_observers(s)

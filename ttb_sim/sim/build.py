@@ -196,7 +196,7 @@ def vehicle_track_setup(scenario: Scenario, structure: Structure,
 
 def build_coupling(scenario: Scenario, structure: Structure, vehicle: Vehicle,
                    integrator: Integrator, irregularity: TrackIrregularity | None, *,
-                   lean: bool = False, reduced: bool = False) -> Coupling:
+                   lean: bool = False, reduced: bool = False, rail_steps: int = 0) -> Coupling:
     """
     Couple the scenario's vehicle model to the structure (the one place that dispatches on it).
 
@@ -214,14 +214,19 @@ def build_coupling(scenario: Scenario, structure: Structure, vehicle: Vehicle,
         Multibody cars on the reduced track-bridge, detailed only around the
         train (:mod:`ttb_sim.sim.coupling.train_track.reduced_track`); the other vehicles
         ignore it.
+    rail_steps : int
+        Multibody cars (``realtime``): on the reduced track-bridge of ``reduced``, with the
+        window's rails and slabs at dt and the rest at rail_steps dt
+        (:class:`~ttb_sim.sim.integrators.multirate.MultiRateNewmark`); 0 = one system.
 
     """
     if isinstance(vehicle, MultibodyCars):
         car = loaded_car(scenario.car, scenario.train.passenger_load)
-        if reduced:
+        if reduced or rail_steps:
             return ReducedTrainTrackCoupling(car, scenario.contact, vehicle.n_cars,
                                              vehicle.car_length, structure, integrator,
-                                             irregularity, scenario.solver.window_margin)
+                                             irregularity, scenario.solver.window_margin,
+                                             rail_steps)
         return TrainTrackCoupling(car, scenario.contact, vehicle.n_cars,
                                   vehicle.car_length, structure, integrator, irregularity)
     if isinstance(vehicle, QuarterCars):

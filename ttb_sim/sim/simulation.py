@@ -145,7 +145,8 @@ class Simulation:
                                       fused=self.variant.fused)
             self.coupling = build_coupling(scenario, st, self.vehicle, self.integrator,
                                            self.irregularity, lean=self.variant.lean,
-                                           reduced=self.variant.reduced)
+                                           reduced=self.variant.reduced,
+                                           rail_steps=self.variant.rail_steps(scenario))
         self.foundations = PiledFoundations(st, dt,
                                             scenario.solver.substructure_steps)
         self.rigid = RigidDisplacement(st)

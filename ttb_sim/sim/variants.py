@@ -44,7 +44,7 @@ from contextlib import contextmanager
 from dataclasses import dataclass
 import logging
 import os
-from typing import Iterator
+from typing import Any, Iterator
 
 log = logging.getLogger(__name__)
 
@@ -71,6 +71,18 @@ class SolverVariant:
     """True to take the steps between frames in the coupling's compiled loop
     (:class:`~ttb_sim.sim.coupling.base.FusedCoupling`), one thread, the effective
     matrix factorised whole (not split)."""
+
+    def rail_steps(self, scenario: Any) -> int:
+        """
+        Return the multi-rate ratio of a scenario's multibody cars under this variant.
+
+        ``solver.rail_steps`` for ``realtime`` with multibody cars (the window of
+        ``reduced`` with its rails and slabs at dt, the rest at rail_steps dt); 0 (one
+        system) otherwise.
+        """
+        if self.fused and scenario.train.vehicle == 'car':
+            return int(scenario.solver.rail_steps)
+        return 0
 
     @property
     def pile_soil_factorization(self) -> str:

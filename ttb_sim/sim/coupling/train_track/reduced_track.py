@@ -59,6 +59,7 @@ import time
 import numpy as np
 import scipy.sparse as sp
 
+from ttb_sim.errors import ModelError
 from ttb_sim.fe.beam import field_rows, offset_rows
 from ttb_sim.fe.factorization import factorize
 from ttb_sim.model.irregularity import TrackIrregularity
@@ -67,6 +68,7 @@ from ttb_sim.model.vehicle.car import CarParameters
 from ttb_sim.model.wheel_rail.contact_parameters import ContactParameters
 from ttb_sim.sim.coupling.train_track.multibody import TrainTrackCoupling
 from ttb_sim.sim.coupling.train_track.rail_compliance import RailCompliance
+from ttb_sim.sim.integrators.multirate import check_coupling, MultiRateNewmark
 from ttb_sim.sim.integrators.newmark import Newmark
 from ttb_sim.sim.integrators.protocol import Integrator
 
@@ -85,6 +87,24 @@ BASIS_DROP = 1e-12
 dropped (round-off: the basis of a slab unit is dense over the unit)."""
 BASIS_CHUNK = 64
 """Bridge DOFs per batch of the static solves that build the basis."""
+
+
+def rail_and_slab_dofs(structure: Structure) -> np.ndarray:
+    """Return the full DOFs of both rails and the slabs (the multi-rate step's fast part)."""
+    track = structure.track
+    if track is None:
+        raise ModelError('the track-bridge has no slab track: no rails and slabs to step apart')
+    lines = (*track.rails, track.slab)
+    return np.unique(np.concatenate([line.dofs.ravel() for line in lines]))
+
+
+def fast_track_range(structure: Structure) -> slice:
+    """Return the free DOFs of the rails and slabs, one contiguous range (the track's first)."""
+    free = structure.full_to_free[rail_and_slab_dofs(structure)]
+    free = np.unique(free[free < structure.n_free])
+    if free[-1] - free[0] + 1 != free.size:
+        raise ModelError('the rails and slabs are not numbered as one range of free DOFs')
+    return slice(int(free[0]), int(free[-1]) + 1)
 
 
 @dataclass(frozen=True)
@@ -355,8 +375,17 @@ class ReducedTrainTrackCoupling(TrainTrackCoupling):
 
     def __init__(self, car: CarParameters, contact: ContactParameters, n_cars: int,
                  car_length: float, structure: Structure, integrator: Integrator,
-                 irregularity: TrackIrregularity | None, margin: float = MARGIN) -> None:
+                 irregularity: TrackIrregularity | None, margin: float = MARGIN,
+                 rail_steps: int = 0) -> None:
         self.margin = float(margin)
+        self.rail_steps = int(rail_steps)
+        """Rail steps per step of the structure under the rails (multi-rate,
+        :class:`~ttb_sim.sim.integrators.multirate.MultiRateNewmark`); 0 = one system."""
+        if self.rail_steps:   # refused before anything steps: every window has these links
+            fast = fast_track_range(structure)
+            slow = np.setdiff1d(np.arange(structure.n_free), np.arange(fast.start, fast.stop))
+            check_coupling(structure.mass, structure.damping, structure.stiffness, fast, slow,
+                           float(integrator.dt), self.rail_steps)
         super().__init__(car, contact, n_cars, car_length, structure, integrator, irregularity)
         self._contact_min = float(np.min(self.contact_x))
         self._contact_max = float(np.max(self.contact_x))
@@ -407,8 +436,13 @@ class ReducedTrainTrackCoupling(TrainTrackCoupling):
         window = track_window(st, *self._bases, rear - self.margin,
                               front + self.margin + ADVANCE)
         t, local = window.basis, window.local_basis
-        self.nm = Newmark(project(st.mass, local), project(st.damping, local),
-                          project(st.stiffness, t), self._dt, method=self._method, lean=True)
+        mass, damping, stiffness = (project(st.mass, local), project(st.damping, local),
+                                    project(st.stiffness, t))
+        self.nm = (MultiRateNewmark(mass, damping, stiffness, self._dt,
+                                    self._fast_dofs(window), self.rail_steps,
+                                    method=self._method)
+                   if self.rail_steps else
+                   Newmark(mass, damping, stiffness, self._dt, method=self._method, lean=True))
         self.static_stiffness = self.nm.stiffness
         self.n_free = window.size
         ftr = window.full_to_reduced
@@ -421,6 +455,11 @@ class ReducedTrainTrackCoupling(TrainTrackCoupling):
         self.window_time += time.process_time() - begin
         log.debug('track window %.1f .. %.1f m: %d of %d DOFs', window.start, window.end,
                   window.size, st.n_free)
+
+    def _fast_dofs(self, window: TrackWindow) -> np.ndarray:
+        """Return the window's rail and slab DOFs (reduced numbering): the fast partition."""
+        reduced = window.full_to_reduced[rail_and_slab_dofs(self.structure)]
+        return np.unique(reduced[reduced < window.size])
 
     def start(self, head: float) -> None:
         """Build the first window and start from the static equilibrium on it."""
