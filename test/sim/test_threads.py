@@ -119,3 +119,14 @@ def test_the_plan_says_threads_and_what_it_compiles():
                           messages_per_frame=3, variant='qdldl')
     assert 'compiling' not in quiet.describe()
     assert plan.wall_time - quiet.wall_time == pytest.approx(plan.compile_time)
+
+
+def test_realtime_takes_one_thread_unless_asked(monkeypatch):
+    """Issue #27: single-threaded by default, even on an idle machine; a set count still holds."""
+    from ttb_sim.sim.variants import solver_variant
+    machine(monkeypatch, 2, 0.0)
+    realtime = solver_variant('realtime')
+    assert resolve_threads(0, realtime).count == 1
+    assert 'realtime' in resolve_threads(0, realtime).reason
+    assert resolve_threads(2, realtime).count == 2
+    assert resolve_threads(0, solver_variant('qdldl')).count == 2

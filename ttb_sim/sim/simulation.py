@@ -136,7 +136,7 @@ class Simulation:
         self.n_steps = max(1, math.ceil(self.duration / dt - 1e-9))
         names = tuple(o.name for o in scenario.output.points)
         self.variant = solver_variant(scenario.solver.variant)
-        self.threads = resolve_threads(scenario.solver.threads)
+        self.threads = resolve_threads(scenario.solver.threads, self.variant)
         """The threads of the parallel kernels (``solver.threads``), chosen once."""
         with blas_threads(self.variant.blas_threads):
             self.integrator = Newmark(st.mass, st.damping, st.stiffness, dt,

@@ -125,7 +125,7 @@ class Threads:
         return f'{self.count} thread{"s" if self.count > 1 else ""} ({self.reason})'
 
 
-def resolve_threads(requested: int) -> Threads:
+def resolve_threads(requested: int, variant: SolverVariant | None = None) -> Threads:
     """
     Return the threads of a run's parallel kernels for ``solver.threads``.
 
@@ -133,10 +133,13 @@ def resolve_threads(requested: int) -> Threads:
     cores this process may run on, less the 1-minute load average, leave at
     least :data:`AUTO_FREE_CORES` free, else one: two threads that wait for each
     other on a busy machine made a step 3.5-11x slower than one thread (issue
-    #28). The results do not depend on the count.
+    #28). ``realtime`` takes one thread at 0 (issue #27: single-threaded by default,
+    threads an opt-in). The results do not depend on the count.
     """
     if requested > 0:
         return Threads(int(requested), 'solver.threads')
+    if variant is not None and variant.fused:
+        return Threads(1, f'{variant.name}: one thread unless solver.threads asks')
     try:
         cores = len(os.sched_getaffinity(0))
     except (AttributeError, OSError):
