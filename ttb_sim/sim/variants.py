@@ -22,9 +22,13 @@ validated path as it was written, with the process's BLAS threads untouched:
 general SuperLU, the plain Newmark step, two track solves per step of the
 multibody cars (whose contact step every variant takes compiled; it agrees with
 the numpy step it replaced to round-off, ``test/sim/contact_oracle.py``).
-``reduced`` is the one variant that changes the model, not only how it is
-solved: the track away from the train rides on the girder (an approximation
-with a stated range, docs/performance.md); it is opt-in.
+``reduced`` changes the model, not only how it is solved: the track away from
+the train rides on the girder (an approximation with a stated range,
+docs/performance.md); it is opt-in. ``realtime`` steps moving forces and quarter
+cars in one compiled loop (the frames of ``qdldl`` bit for bit) and multibody cars
+on the window of ``reduced`` with its rails and slabs at dt and the structure under
+them at ``solver.rail_steps`` dt (:mod:`ttb_sim.sim.integrators.multirate`, an
+approximation within issue #27's budget, measured by ``ttb-sim bench``).
 A pile-soil substructure on its own (``scenario.substructure_only``,
 :mod:`ttb_sim.sim.substructure.standalone`) reads the same table: ``reference`` steps
 it fully implicit (one factorisation of every DOF, the validated Newmark

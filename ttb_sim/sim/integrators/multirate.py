@@ -203,6 +203,11 @@ class MultiRateNewmark:
         self._finish_kernel = KERNELS.compiled('finish')
         self._load_kernel = KERNELS.compiled('effective_load')
 
+    @property
+    def at_slow_step(self) -> bool:
+        """Tell whether the last step closed a slow step (the state is whole: S corrected)."""
+        return self._phase == 0
+
     # -- the integrator protocol ---------------------------------------------------------
 
     def fused_arrays(self) -> tuple[np.ndarray, ...] | None:

@@ -473,7 +473,8 @@ class ReducedTrainTrackCoupling(TrainTrackCoupling):
         """Move the window when the train nears its end, then take the coupled step."""
         assert self.window is not None, 'start() first'
         rear, front = self._axle_span(head)
-        if front + self.margin > self.window.end or rear < self.window.start:
+        due = front + self.margin > self.window.end or rear < self.window.start
+        if due and getattr(self.nm, 'at_slow_step', True):
             self._move_window(head)
         super().step(head, speed)
 
