@@ -88,3 +88,24 @@ def test_a_track_too_stiff_for_the_exchange_is_refused_before_stepping():
                                             'track.layer_stiffness=1e10'])
     with pytest.raises(ModelError, match=r"'realtime' does not apply .* allowed 'reduced'"):
         Simulation(scenario)
+
+
+def test_the_window_moves_only_where_a_slow_step_closes(monkeypatch):
+    """A move inside a slow step injected a transient (5x the deflection; diverged at 1.6 s)."""
+    from ttb_sim.sim.coupling.train_track.reduced_track import ReducedTrainTrackCoupling
+
+    phases = []
+    original = ReducedTrainTrackCoupling._move_window
+
+    def recording(self, head):
+        phases.append(getattr(self.nm, '_phase', 0) if self.window is not None else 0)
+        original(self, head)
+
+    monkeypatch.setattr(ReducedTrainTrackCoupling, '_move_window', recording)
+    moving = [*SMALL[:-1], 'solver.window_margin=5', 'solver.duration=0.6',
+              'train.start_position=10']
+    _, traces = measure('paper_ttbi', 'realtime', None, [*moving, 'solver.rail_steps=5'])
+    assert len(phases) >= 2 and all(p == 0 for p in phases), phases
+    _, one = measure('paper_ttbi', 'reduced', None, moving)
+    found = differences(traces, one)
+    assert all(found[name] <= BUDGET[name] for name in BUDGET), found
