@@ -46,6 +46,8 @@ the end of each macro step.
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as sla
@@ -139,6 +141,9 @@ class MultiRateNewmark:
         Fast steps per slow step (1 steps both at dt, still staggered).
     method : str
         Factorisation of both effective matrices.
+    check : bool
+        Refuse a stiff link (:func:`check_coupling`); False where the caller checked the
+        same links already (each window of a moving one).
 
     """
 
@@ -146,7 +151,8 @@ class MultiRateNewmark:
     """The couplings take their lean (single-solve) step with it."""
 
     def __init__(self, mass: sp.spmatrix, damping: sp.spmatrix, stiffness: sp.spmatrix,
-                 dt: float, fast: np.ndarray, ratio: int, *, method: str = 'qdldl') -> None:
+                 dt: float, fast: np.ndarray, ratio: int, *, method: str = 'qdldl',
+                 check: bool = True) -> None:
         self.dt = float(dt)
         self.a0 = 4.0 / self.dt**2
         self.a1 = 2.0 / self.dt
@@ -163,9 +169,9 @@ class MultiRateNewmark:
         self.n_fast, self.n_slow = fast.size, self.slow.size
         f, s = self.fast, self.slow
         self.ratio = int(ratio)
-        self.gain = check_coupling(self.mass, self.damping, self.stiffness, f, s, self.dt,
-                                   self.ratio)
-        """The exchange's :func:`coupling_gain`."""
+        self.gain = (check_coupling(self.mass, self.damping, self.stiffness, f, s, self.dt,
+                                    self.ratio) if check else math.nan)
+        """The exchange's :func:`coupling_gain` (NaN when not checked here)."""
         m_ff, c_ff = _block(self.mass, f, f), _block(self.damping, f, f)
         # each factorised whole, solved on one thread (split halves on two threads collapse
         # on a shared machine: 3.05 against 0.58 ms a fast solve of paper_ttbi beside a run)

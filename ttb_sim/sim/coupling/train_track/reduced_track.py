@@ -440,7 +440,7 @@ class ReducedTrainTrackCoupling(TrainTrackCoupling):
                                     project(st.stiffness, t))
         self.nm = (MultiRateNewmark(mass, damping, stiffness, self._dt,
                                     self._fast_dofs(window), self.rail_steps,
-                                    method=self._method)
+                                    method=self._method, check=False)
                    if self.rail_steps else
                    Newmark(mass, damping, stiffness, self._dt, method=self._method, lean=True))
         self.static_stiffness = self.nm.stiffness
