@@ -48,7 +48,10 @@ from contextlib import contextmanager
 from dataclasses import dataclass
 import logging
 import os
-from typing import Any, Iterator
+from typing import Iterator, TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from ttb_sim.config import Scenario
 
 log = logging.getLogger(__name__)
 
@@ -76,7 +79,7 @@ class SolverVariant:
     (:class:`~ttb_sim.sim.coupling.base.FusedCoupling`), one thread, the effective
     matrix factorised whole (not split)."""
 
-    def rail_steps(self, scenario: Any) -> int:
+    def rail_steps(self, scenario: Scenario) -> int:
         """
         Return the multi-rate ratio of a scenario's multibody cars under this variant.
 

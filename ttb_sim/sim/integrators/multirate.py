@@ -50,11 +50,10 @@ import math
 
 import numpy as np
 import scipy.sparse as sp
-import scipy.sparse.linalg as sla
 
 from ttb_sim.errors import ModelError
 from ttb_sim.fe.compiled import sparse_arrays
-from ttb_sim.sim.integrators.newmark import Newmark
+from ttb_sim.sim.integrators.newmark import Newmark, SteppedIntegrator
 from ttb_sim.sim.integrators.newmark_kernels import KERNELS
 
 __all__ = ['check_coupling', 'coupling_gain', 'MAX_COUPLING_GAIN', 'MultiRateNewmark']
@@ -124,7 +123,7 @@ def _block(matrix: sp.csr_matrix, rows: np.ndarray | slice,
     return part
 
 
-class MultiRateNewmark:
+class MultiRateNewmark(SteppedIntegrator):
     """
     Newmark at dt on a fast partition and at ``ratio`` dt on the rest (module docstring).
 
@@ -185,6 +184,7 @@ class MultiRateNewmark:
         stacked = sp.hstack([m_ff, c_ff, _block(self.stiffness, f, s),
                              _block(self.damping, f, s), _block(self.mass, f, s)], format='csr')
         stacked.eliminate_zeros()
+        self._fine_matrix = stacked
         self._fine_rows = sparse_arrays(stacked)
         nf, ns = self.n_fast, self.n_slow
         self._operand = np.zeros(2 * nf + 3 * ns)
@@ -195,7 +195,11 @@ class MultiRateNewmark:
         slow_rows = sp.hstack([_block(self.stiffness, s, f), _block(self.damping, s, f),
                                _block(self.mass, s, f)], format='csr')
         slow_rows.eliminate_zeros()
+        self._slow_matrix = slow_rows
         self._slow_rows = sparse_arrays(slow_rows)
+        self._slow_index = np.full(n, -1, dtype=np.int64)
+        self._slow_index[s] = np.arange(s.size)
+        """Position of each free DOF among the slow ones (-1: fast)."""
         self._fast_state = np.zeros(3 * nf)
         self.external: tuple[np.ndarray, np.ndarray] | None = None
         """Load on the slow partition at the end of the step, (DOFs, values) (see
@@ -267,12 +271,10 @@ class MultiRateNewmark:
         if self._load_kernel is not None:
             self._load_kernel(*self._fine_rows, self._operand, force_f, rhs[f])
         else:
-            indptr, indices, data = self._fine_rows
-            rows = sp.csr_matrix((data, indices.astype(np.int64), indptr.astype(np.int64)),
-                                 shape=(self.n_fast, self._operand.size))
-            rhs[f] = force_f - rows @ self._operand
+            rhs[f] = force_f - self._fine_matrix @ self._operand
         rhs[self.slow] = self._u_p
-        self._force_slow = force[self.slow]
+        if self._phase == self.ratio - 1:   # the slow step's own load, at its end
+            self._force_slow = force[self.slow]
         return rhs
 
     def solve(self, rhs: np.ndarray) -> np.ndarray:
@@ -318,29 +320,9 @@ class MultiRateNewmark:
             self._load_kernel(*self._slow_rows, self._fast_state,
                               np.ascontiguousarray(self._force_slow), load)
         else:
-            indptr, indices, data = self._slow_rows
-            rows = sp.csr_matrix((data, indices.astype(np.int64), indptr.astype(np.int64)),
-                                 shape=(self.n_slow, 3 * nf))
-            load = self._force_slow - rows @ self._fast_state
-        if self.external is not None:
+            load = self._force_slow - self._slow_matrix @ self._fast_state
+        if self.external is not None:   # the bearing forces of partitioned piled piers
             dofs, values = self.external
-            full = np.zeros(u_new.shape[0])
-            np.add.at(full, dofs, values)
-            load += full[self.slow]
+            where = self._slow_index[dofs]
+            np.add.at(load, where[where >= 0], np.asarray(values)[where >= 0])
         return load
-
-    def step(self, u: np.ndarray, v: np.ndarray, a: np.ndarray,
-             force: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """Advance an uncoupled system by one fine step."""
-        h_v, h_a = self.history(u, v, a)
-        u_new = self.solve(self.effective_load(force, h_v, h_a))
-        v_new, a_new = self.finish(u_new, h_v, h_a)
-        return u_new, v_new, a_new
-
-    def initial_acceleration(self, u: np.ndarray, v: np.ndarray,
-                             force: np.ndarray) -> np.ndarray:
-        """Return M^-1 (f - C v - K u), the acceleration consistent with a start state."""
-        rhs = force - self.damping @ v - self.stiffness @ u
-        if not np.any(rhs):
-            return np.zeros_like(rhs)
-        return np.asarray(sla.spsolve(self.mass.tocsc(), rhs))

@@ -24,7 +24,75 @@ from ttb_sim.fe.factorization import factorize
 from ttb_sim.sim.integrators.newmark_kernels import KERNELS
 
 
-class Newmark:
+class SteppedIntegrator:
+    """
+    What every integrator of the protocol derives from its pieces.
+
+    :meth:`step` is history, effective load, solve and finish in turn;
+    :meth:`initial_acceleration` solves with the mass matrix; :attr:`at_slow_step` tells a
+    coupling that may rebuild its integrator (a moving window) that the state is whole.
+    Subclasses give ``mass``, ``damping``, ``stiffness`` and the four pieces.
+    """
+
+    mass: sp.csr_matrix
+    damping: sp.csr_matrix
+    stiffness: sp.csr_matrix
+
+    @property
+    def at_slow_step(self) -> bool:
+        """Tell whether the state is complete, so the integrator may be replaced (always here)."""
+        return True
+
+    def history(self, u: np.ndarray, v: np.ndarray,
+                a: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Return (h_v, h_a) (see :class:`~ttb_sim.sim.integrators.protocol.Integrator`)."""
+        raise NotImplementedError
+
+    def effective_load(self, force: np.ndarray, h_v: np.ndarray, h_a: np.ndarray) -> np.ndarray:
+        """Return the effective right-hand side for the load at t_{n+1}."""
+        raise NotImplementedError
+
+    def solve(self, rhs: np.ndarray) -> np.ndarray:
+        """Apply the effective compliance."""
+        raise NotImplementedError
+
+    def finish(self, u_new: np.ndarray, h_v: np.ndarray,
+               h_a: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Return the end-of-step velocity and acceleration."""
+        raise NotImplementedError
+
+    def step(self, u: np.ndarray, v: np.ndarray, a: np.ndarray,
+             force: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """
+        Advance one step of an uncoupled system.
+
+        Parameters
+        ----------
+        u, v, a : arrays
+            State at t_n.
+        force : array
+            Load at t_{n+1}.
+
+        Returns
+        -------
+        (u, v, a) at t_{n+1}.
+
+        """
+        h_v, h_a = self.history(u, v, a)
+        u_new = self.solve(self.effective_load(force, h_v, h_a))
+        v_new, a_new = self.finish(u_new, h_v, h_a)
+        return u_new, v_new, a_new
+
+    def initial_acceleration(self, u: np.ndarray, v: np.ndarray,
+                             force: np.ndarray) -> np.ndarray:
+        """Return M^-1 (f - C v - K u), the acceleration consistent with a start state."""
+        rhs = force - self.damping @ v - self.stiffness @ u
+        if not np.any(rhs):
+            return np.zeros_like(rhs)
+        return np.asarray(sla.spsolve(self.mass.tocsc(), rhs))
+
+
+class Newmark(SteppedIntegrator):
     """
     Newmark's average-acceleration method (beta = 1/4, gamma = 1/2) for M a + C v + K u = f.
 
@@ -166,33 +234,3 @@ class Newmark:
             v, a = self._finish_kernel(u_new, self.a0, self.a1, h_v, h_a)
             return v, a
         return self.a1 * u_new + h_v, self.a0 * u_new + h_a
-
-    def step(self, u: np.ndarray, v: np.ndarray, a: np.ndarray,
-             force: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """
-        Advance one step of an uncoupled system.
-
-        Parameters
-        ----------
-        u, v, a : arrays
-            State at t_n.
-        force : array
-            Load at t_{n+1}.
-
-        Returns
-        -------
-        (u, v, a) at t_{n+1}.
-
-        """
-        h_v, h_a = self.history(u, v, a)
-        u_new = self.solve(self.effective_load(force, h_v, h_a))
-        v_new, a_new = self.finish(u_new, h_v, h_a)
-        return u_new, v_new, a_new
-
-    def initial_acceleration(self, u: np.ndarray, v: np.ndarray,
-                             force: np.ndarray) -> np.ndarray:
-        """Return M^-1 (f - C v - K u), the acceleration consistent with a start state."""
-        rhs = force - self.damping @ v - self.stiffness @ u
-        if not np.any(rhs):
-            return np.zeros_like(rhs)
-        return sla.spsolve(self.mass.tocsc(), rhs)

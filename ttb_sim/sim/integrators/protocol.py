@@ -58,6 +58,10 @@ class Integrator(Protocol):
     (unique), values): the substructures' bearing forces on the girders, set through
     :meth:`~ttb_sim.sim.coupling.base.Coupling.load_bridge` before each step."""
 
+    @property
+    def at_slow_step(self) -> bool:
+        """Tell whether the state is complete, so that the integrator may be replaced."""
+
     def fused_arrays(self) -> tuple[np.ndarray, ...] | None:
         """Return the arrays a compiled multi-step loop reads, or None (it does not apply)."""
 

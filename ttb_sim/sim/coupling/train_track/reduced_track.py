@@ -474,7 +474,7 @@ class ReducedTrainTrackCoupling(TrainTrackCoupling):
         assert self.window is not None, 'start() first'
         rear, front = self._axle_span(head)
         due = front + self.margin > self.window.end or rear < self.window.start
-        if due and getattr(self.nm, 'at_slow_step', True):
+        if due and self.nm.at_slow_step:
             self._move_window(head)
         super().step(head, speed)
 
