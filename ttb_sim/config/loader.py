@@ -16,14 +16,16 @@
 
 from __future__ import annotations
 
+import dataclasses
 from pathlib import Path
 import re
 import sys
 import sysconfig
+import typing
 from typing import Any, Sequence, TYPE_CHECKING
 
 from ttb_sim.config.schema import (canonical_key, coerce_value, from_mapping, key_spec,
-                                   section_problem)
+                                   record_item, section_problem, to_plain)
 from ttb_sim.errors import ScenarioError
 from ttb_sim.inputs import MAX_SHOWN, read_user_file, shown
 import yaml
@@ -314,6 +316,9 @@ def apply_overrides(data: dict[str, Any], overrides: Sequence[tuple[str, Any]]) 
 
     """
     for key, value in overrides:
+        if ITEM_KEY.match(key):
+            _apply_item_override(data, key, value)
+            continue
         problem = section_problem(canonical_key(key))
         if problem is not None:
             message = f'{key} = {shown(value)}: {problem}'
@@ -330,6 +335,83 @@ def apply_overrides(data: dict[str, Any], overrides: Sequence[tuple[str, Any]]) 
                 node[part] = child
             node = child
         node[parts[-1]] = value
+
+
+ITEM_KEY = re.compile(r'^(?P<list>[a-z_][a-z0-9_.]*)\[(?P<index>\d+)\]'
+                      r'(?:\.(?P<field>[A-Za-z_][A-Za-z0-9_]*))?$')
+"""A key into one entry of a list-valued key: ``damage.girders[0].loss``,
+``environment.soil_modulus_scale[1]``."""
+
+
+def _apply_item_override(data: dict[str, Any], key: str, value: Any) -> None:
+    """
+    Set one entry of a list-valued key (or one field of it), in place.
+
+    The list is the one given so far (in the file or by an earlier override), or the
+    key's default; the index must name an entry of it.  The value is checked against
+    the entry's declaration (the field's for a list of records, the key's for a list
+    of numbers); the whole list is checked again when the scenario is built.
+
+    Raises
+    ------
+    ScenarioError
+        For an unknown list key or field, an index past the list's end, or a bad value.
+
+    """
+    match = ITEM_KEY.match(key)
+    assert match is not None
+    list_key, index, field = match['list'], int(match['index']), match['field']
+    typ, default, spec = key_spec(list_key)   # raises on unknown keys
+    list_key = canonical_key(list_key)
+    record = record_item(typ)
+    if record is None and field is not None:
+        raise ScenarioError(f'{key} = {shown(value)}: {list_key} is a list of values, not of '
+                            f'records; set {list_key}[{index}] itself')
+    if record is not None and field is None:
+        fields = ', '.join(f.name for f in dataclasses.fields(record))
+        raise ScenarioError(f'{key} = {shown(value)}: {list_key}[{index}] is a record; set one '
+                            f'of its keys, e.g. {list_key}[{index}].{fields.split(", ")[0]} '
+                            f'(keys: {fields})')
+    if typing.get_origin(typ) is not tuple:
+        raise ScenarioError(f'{key} = {shown(value)}: {list_key} is not a list; set it as '
+                            f'{list_key}=VALUE')
+    node = data
+    parts = list_key.split('.')
+    for part in parts[:-1]:
+        child = node.get(part)
+        if not isinstance(child, dict):
+            child = {}
+            node[part] = child
+        node = child
+    current = node.get(parts[-1], [dataclasses.asdict(e) if dataclasses.is_dataclass(e)
+                                   else e for e in to_plain(default or [])])
+    if not isinstance(current, (list, tuple)):
+        raise ScenarioError(f'{key} = {shown(value)}: {list_key} is {shown(current)}, not a '
+                            'list; give the list first')
+    entries = [dict(e) if isinstance(e, dict) else e for e in current]
+    if index >= len(entries):
+        have = f'has {len(entries)} entries (index 0 to {len(entries) - 1})' if entries \
+            else 'has no entries'
+        raise ScenarioError(f'{key} = {shown(value)}: {list_key} {have}; give the entry in '
+                            f'the scenario (or as {list_key}=[...]) before setting a key of it')
+    if record is not None:
+        names = {f.name: f for f in dataclasses.fields(record)}
+        if field not in names:
+            raise ScenarioError(f'{key} = {shown(value)}: unknown key {field!r} in an entry of '
+                                f'{list_key}; allowed: {", ".join(names)}')
+        hints = typing.get_type_hints(record)
+        coerce_value(key, value, hints[field], names[field].metadata['spec'])
+        if not isinstance(entries[index], dict):
+            raise ScenarioError(f'{key}: {list_key}[{index}] is {shown(entries[index])}, not '
+                                'a mapping')
+        entries[index][field] = value
+    else:
+        element = typing.get_args(typ)[0] if typing.get_args(typ) else float
+        if element not in (int, float):
+            raise ScenarioError(f'{key}: the entries of {list_key} are not numbers')
+        coerce_value(key, [value], typ, spec)
+        entries[index] = value
+    node[parts[-1]] = entries
 
 
 def load_scenario(source: str | Path, overrides: Sequence[str] = (),
