@@ -312,7 +312,7 @@ class _Hung(BaseException):
 
 
 EXPENSIVE = ('ttb_sim.sim.make_runner', 'ttb_sim.commands.validate.run_cases',
-             'ttb_sim.commands.sweep._Local', 'ttb_sim.commands.sweep._Dask',
+             'ttb_sim.commands.pool.LocalPool', 'ttb_sim.commands.pool.DaskPool',
              'ttb_sim.commands.bench.measure', 'ttb_sim.commands.bench.measure_isolated',
              'ttb_sim.sim.build_structure', 'ttb_sim.report.metrics.bag_metrics')
 """The first step of each verb after its argument checks: building or stepping a model,

@@ -30,7 +30,7 @@ import numpy as np
 import pytest
 
 from ttb_sim.cli import main
-from ttb_sim.commands import sweep as sweep_module
+from ttb_sim.commands import pool as pool_module
 from ttb_sim.io.reader import read_bag
 
 ARGS = ['sweep', 'moving_force_beam', '--duration', '0.1']
@@ -108,7 +108,7 @@ def test_bad_arguments_exit_2_before_anything(tmp_path, capsys, args, message):
 
 def test_unreachable_scheduler_exit_2(tmp_path, capsys, monkeypatch):
     pytest.importorskip('dask.distributed', reason="Dask is an extra: pip install '.[dask]'")
-    monkeypatch.setattr(sweep_module, 'SCHEDULER_TIMEOUT_S', 1.0)
+    monkeypatch.setattr(pool_module, 'SCHEDULER_TIMEOUT_S', 1.0)
     out = tmp_path / 'sw'
     assert main([*ARGS, '--speeds-kmh', '300', '--scheduler', 'tcp://127.0.0.1:9',
                  '--out', str(out)]) == 2

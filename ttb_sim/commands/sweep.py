@@ -32,20 +32,16 @@ case starts.
 
 from __future__ import annotations
 
-from concurrent.futures import as_completed, Future, ProcessPoolExecutor
 import csv
 import json
 import logging
-import multiprocessing
-import os
 from pathlib import Path
-import signal
 import sys
-import threading
 import time
-from typing import Any, Callable, Iterator, Sequence
+from typing import Any, Sequence
 
-from ttb_sim.commands.signals import raise_stopped, signal_name, SignalHandlers, Stopped
+from ttb_sim.commands.pool import check_workers, make_pool, run_cases
+from ttb_sim.commands.signals import signal_name
 from ttb_sim.commands.sweep_case import case_row, CaseSpec, is_finished, run_case
 from ttb_sim.config import load_scenario
 from ttb_sim.errors import ScenarioError
@@ -56,8 +52,6 @@ log = logging.getLogger(__name__)
 EXIT_OK, EXIT_FAILURE = 0, 1
 MAX_CASES = 10_000
 """Most cases one sweep accepts."""
-SCHEDULER_TIMEOUT_S = 10.0
-"""How long to wait for a Dask scheduler before giving up (exit 2)."""
 
 
 def parse_speeds(text: str) -> list[float]:
@@ -122,98 +116,8 @@ def _check_settings(out: Path, settings: dict[str, Any]) -> None:
                             '(no sweep.json); give a new or empty folder')
 
 
-def _start_worker(workers: int) -> None:
-    """
-    Worker initializer: Ctrl-C is the parent's to handle (it terminates the workers).
-
-    With several workers each runs its compiled kernels on one thread: the cores are
-    already shared out by the processes, and a kernel's second thread would only
-    contend with another case (the results do not depend on the thread count).
-    """
-    signal.signal(signal.SIGINT, signal.SIG_IGN)
-    if workers > 1:
-        os.environ['NUMBA_NUM_THREADS'] = '1'
-
-
-class _Local:
-    """Cases in local worker processes (spawned, so each starts clean)."""
-
-    def __init__(self, workers: int) -> None:
-        self.pool = ProcessPoolExecutor(max_workers=workers,
-                                        mp_context=multiprocessing.get_context('spawn'),
-                                        initializer=_start_worker, initargs=(workers,))
-
-    def submit(self, cases: Sequence[CaseSpec]) -> None:
-        """Queue the cases (this starts the worker processes)."""
-        self.futures: dict[Future[dict[str, Any]], CaseSpec] = {
-            self.pool.submit(run_case, c): c for c in cases}
-
-    def results(self) -> Iterator[tuple[CaseSpec, dict[str, Any]]]:
-        """Yield (case, record) as cases finish."""
-        for fut in as_completed(self.futures):
-            yield self.futures[fut], _result(self.futures[fut], fut.result, fut.exception)
-
-    def close(self) -> None:
-        self.pool.shutdown(wait=True, cancel_futures=True)
-
-    def stop(self) -> None:
-        """Terminate the workers at once (their cases have no case.json: redone next time)."""
-        for process in list(getattr(self.pool, '_processes', {}).values()):
-            process.terminate()
-        self.pool.shutdown(wait=False, cancel_futures=True)
-
-
-class _Dask:
-    """Cases on a Dask distributed cluster (the workers need ttb_sim and the out folder)."""
-
-    def __init__(self, address: str) -> None:
-        try:
-            from dask.distributed import Client
-        except ImportError:
-            raise ScenarioError("--scheduler needs Dask: pip install 'ttb_sim[dask]' (or "
-                                "pip install 'dask[distributed]')") from None
-        try:
-            self.client = Client(address, timeout=SCHEDULER_TIMEOUT_S,
-                                 set_as_default=False)
-        except (OSError, TimeoutError, ValueError) as exc:
-            raise ScenarioError(f'--scheduler {address!r} is not reachable within '
-                                f'{SCHEDULER_TIMEOUT_S:g} s ({type(exc).__name__}: {exc}); '
-                                'give the address of a running dask scheduler, e.g. '
-                                'tcp://host:8786') from None
-        self.futures: list[Any] = []
-        self.by_key: dict[Any, CaseSpec] = {}
-        workers = self.client.scheduler_info().get('workers', {})
-        log.info('Dask scheduler %s with %d workers', address, len(workers))
-
-    def submit(self, cases: Sequence[CaseSpec]) -> None:
-        """Send the cases to the scheduler."""
-        keys = [f'ttb-sim-{c.name}-{os.getpid()}-{time.time_ns()}' for c in cases]
-        self.futures = self.client.map(run_case, list(cases), pure=False, key=keys)
-        self.by_key = {f.key: c for f, c in zip(self.futures, cases)}
-
-    def results(self) -> Iterator[tuple[CaseSpec, dict[str, Any]]]:
-        """Yield (case, record) as cases finish."""
-        from dask.distributed import as_completed as dask_completed
-        for fut in dask_completed(self.futures, loop=self.client.loop):
-            case = self.by_key[fut.key]
-            yield case, _result(case, fut.result, fut.exception)
-
-    def close(self) -> None:
-        self.client.close()
-
-    def stop(self) -> None:
-        """Cancel the cases still queued or running on the cluster, and disconnect."""
-        if self.futures:
-            self.client.cancel(list(self.futures))
-        self.client.close()
-
-
-def _result(case: CaseSpec, result: Callable[[], dict[str, Any]],
-            exception: Callable[[], BaseException | None]) -> dict[str, Any]:
-    """Return a case's record, or a failed record when its worker died."""
-    error = exception()
-    if error is None:
-        return result()
+def _lost(case: CaseSpec, error: BaseException) -> dict[str, Any]:
+    """Return the failed record of a case whose worker died."""
     return {'case': case.name, 'speed_kmh': case.speed_kmh, 'seed': case.seed,
             'status': 'failed', 'error': f'worker lost: {type(error).__name__}: {error}'}
 
@@ -225,11 +129,7 @@ def sweep(scenario: str, *, speeds_kmh: str, seeds: int | None = None,
     """Run ``ttb-sim sweep``; return 0 when every case succeeded, 1 otherwise."""
     start = time.perf_counter()
     speeds = parse_speeds(speeds_kmh)
-    if workers is not None and scheduler is not None:
-        raise ScenarioError('give either --workers (local processes) or --scheduler (Dask), '
-                            'not both')
-    if workers is not None and not 1 <= workers <= 1024:
-        raise ScenarioError(f'--workers {workers} must be from 1 to 1024')
+    check_workers(workers, scheduler)
     name = load_scenario(scenario, overrides).name
     target = Path(out) if out is not None else Path('runs') / f'sweep-{name}'
     settings = {'scenario': str(scenario), 'overrides': list(overrides), 'duration': duration,
@@ -244,42 +144,18 @@ def sweep(scenario: str, *, speeds_kmh: str, seeds: int | None = None,
     if done:
         print(f'ttb-sim: sweep: {len(done)} of {len(cases)} cases already finished, skipped '
               f'({", ".join(c.name for c in done)})', file=sys.stderr)
-    runner: _Local | _Dask | None = None
-    if todo:
-        runner = _Dask(scheduler) if scheduler else \
-            _Local(workers or min(len(todo), os.cpu_count() or 1))
+    pool = make_pool(run_case, len(todo), workers, scheduler) if todo else None
     target.mkdir(parents=True, exist_ok=True)
     write_json(target / 'sweep.json', {'settings': settings, 'speeds_kmh': speeds,
                                        'seeds': seeds, 'cases': [c.name for c in cases]})
-    where = f'Dask scheduler {scheduler}' if scheduler else \
-        f'{workers or min(len(todo), os.cpu_count() or 1)} local worker process(es)'
-    if todo:
-        print(f'ttb-sim: sweep: running {len(todo)} cases on {where}', file=sys.stderr)
-    main_thread = threading.current_thread() is threading.main_thread()
-    handlers = SignalHandlers()
-    if main_thread:   # workers start with Ctrl-C ignored (inherited): the parent handles it
-        handlers.install(signal.SIG_IGN, (signal.SIGINT,))
-    try:
-        if runner is not None:
-            runner.submit(todo)
-        if main_thread:
-            handlers.install(raise_stopped)
-        for i, (case, record) in enumerate(runner.results() if runner else [], start=1):
-            records[case.name] = record
-            detail = f'in {record.get("wall_time_s", 0.0) or 0.0:.1f} s' \
-                if record['status'] == 'ok' else f'{record["status"]}: {record.get("error")}'
-            print(f'ttb-sim: sweep: [{i}/{len(todo)}] {case.name} {record["status"]} {detail}',
-                  file=sys.stderr, flush=True)
-        if runner is not None:
-            runner.close()
-    except Stopped as stop:
-        if runner is not None:
-            runner.stop()
-        print(f'ttb-sim: stopped by {signal_name(stop.signum)}; {len(records)} of {len(cases)} '
-              f'cases finished in {target} (rerun the same command to resume)', file=sys.stderr)
-        return 128 + stop.signum
-    finally:
-        handlers.restore()
+    if pool is not None:
+        stop = run_cases(pool, todo, _lost, 'sweep',
+                         lambda case, record: records.__setitem__(case.name, record))
+        if stop is not None:
+            print(f'ttb-sim: stopped by {signal_name(stop.signum)}; {len(records)} of '
+                  f'{len(cases)} cases finished in {target} (rerun the same command to '
+                  'resume)', file=sys.stderr)
+            return 128 + stop.signum
     rows = [case_row(records[c.name]) for c in cases if c.name in records]
     _write_csv(target / 'sweep.csv', rows)
     from ttb_sim.report.sweep_figures import sweep_figures
