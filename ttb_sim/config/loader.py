@@ -383,8 +383,7 @@ def _apply_item_override(data: dict[str, Any], key: str, value: Any) -> None:
             child = {}
             node[part] = child
         node = child
-    current = node.get(parts[-1], [dataclasses.asdict(e) if dataclasses.is_dataclass(e)
-                                   else e for e in to_plain(default or [])])
+    current = node.get(parts[-1], [_plain_entry(e) for e in to_plain(default or [])])
     if not isinstance(current, (list, tuple)):
         raise ScenarioError(f'{key} = {shown(value)}: {list_key} is {shown(current)}, not a '
                             'list; give the list first')
@@ -412,6 +411,13 @@ def _apply_item_override(data: dict[str, Any], key: str, value: Any) -> None:
         coerce_value(key, [value], typ, spec)
         entries[index] = value
     node[parts[-1]] = entries
+
+
+def _plain_entry(entry: Any) -> Any:
+    """Return one entry of a list default as plain data (a record as its mapping)."""
+    if dataclasses.is_dataclass(entry) and not isinstance(entry, type):
+        return dataclasses.asdict(entry)
+    return entry
 
 
 def load_scenario(source: str | Path, overrides: Sequence[str] = (),
