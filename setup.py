@@ -56,7 +56,9 @@ setup(
         # `filters: public`
         'docs': ['mkdocs>=1.6', 'mkdocs-material>=9', 'mkdocstrings[python]>=1.0',
                  'mkdocstrings-python>=2.0'],
-        'test': ['dask[distributed]>=2023.1',
+        # ttb-sim dataset's table (Parquet)
+        'twin': ['pyarrow>=14'],
+        'test': ['dask[distributed]>=2023.1', 'pyarrow>=14', 'pandas>=2',
                  'pytest>=7', 'mcap>=1.1', 'mcap-ros2-support>=0.5', 'flake8>=6',
                  'flake8-quotes', 'flake8-import-order', 'flake8-builtins',
                  'flake8-comprehensions', 'flake8-class-newline', 'flake8-blind-except',

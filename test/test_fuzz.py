@@ -486,7 +486,7 @@ def test_fuzz_cli_argument_vectors(examples: int, workspace: _Workspace, argv: l
 @pytest.mark.parametrize('argv', [
     ['analyze', 'broken_bag'], ['analyze', 'cut_bag'],
     ['run', 'moving_force_beam', '--set', 'train=5'], ['run', 'twice.yaml'],
-    ['sweep', 'empty.yaml', '--speeds-kmh', '1'], ['compare', 'bag'],
+    ['sweep', 'empty.yaml', '--speeds-kmh', '1'], ['compare', 'bag'], ['dataset', 'empty.yaml'],
     ['run', 'sprung_mass_beam', '--set', 'irregularity.file=bad.csv'], ['modes', 'a\x01b'],
 ], ids=lambda argv: ' '.join(argv))
 def test_the_program_refuses_in_one_line(workspace: _Workspace, argv: list[str]) -> None:

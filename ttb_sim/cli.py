@@ -188,6 +188,19 @@ def _add_bag_verbs(sub: Any) -> None:
                        "tcp://host:8786 (pip install 'ttb_sim[dask]')")
     sw.add_argument('--force', action='store_true', help='run cases above the step budget')
 
+    ds = sub.add_parser('dataset', help='labelled passages drawn from priors over scenario '
+                        'keys, as one Parquet table (docs/twin.md)')
+    ds.add_argument('spec', help='dataset spec (YAML): scenario, n, sampler, seed, priors, ...')
+    ds.add_argument('--out', type=Path, help='data-set folder (default ./runs/dataset-SPEC); a '
+                    'rerun with the same folder skips finished cases')
+    ds.add_argument('--n', type=int, help="number of cases (replaces the spec's n)")
+    where = ds.add_mutually_exclusive_group()
+    where.add_argument('--workers', type=int, help='local worker processes (default: the '
+                       'number of cores, at most the number of cases)')
+    where.add_argument('--scheduler', metavar='ADDRESS', help='Dask scheduler, e.g. '
+                       "tcp://host:8786 (pip install 'ttb_sim[dask]')")
+    ds.add_argument('--force', action='store_true', help='run cases above the step budget')
+
     sc = sub.add_parser('scenarios', help='list the built-in scenarios')
     sc.add_argument('--keys', action='store_true',
                     help='list every scenario key with unit, default and range')
@@ -290,6 +303,10 @@ def _main(argv: Sequence[str] | None) -> int:
                          overrides=args.overrides, out=args.out, workers=args.workers,
                          scheduler=args.scheduler, duration=args.duration,
                          storage=args.storage, force=args.force)
+        if args.command == 'dataset':
+            from ttb_sim.commands.dataset import dataset
+            return dataset(args.spec, out=args.out, n=args.n, workers=args.workers,
+                           scheduler=args.scheduler, force=args.force)
         if args.command == 'bench':
             from ttb_sim.commands.bench import bench_command
             return bench_command(args.scenarios, variants=args.variants,
