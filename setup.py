@@ -56,9 +56,12 @@ setup(
         # `filters: public`
         'docs': ['mkdocs>=1.6', 'mkdocs-material>=9', 'mkdocstrings[python]>=1.0',
                  'mkdocstrings-python>=2.0'],
-        # ttb-sim dataset's table (Parquet)
-        'twin': ['pyarrow>=14'],
-        'test': ['dask[distributed]>=2023.1', 'pyarrow>=14', 'pandas>=2',
+        # the twin workflows: dataset's table (Parquet, pyarrow), identify's sampler (emcee,
+        # MIT), its surrogate (scikit-learn's Gaussian process, BSD), its corner plot (corner,
+        # BSD)
+        'twin': ['pyarrow>=14', 'emcee>=3.1', 'scikit-learn>=1.3', 'corner>=2.2'],
+        'test': ['dask[distributed]>=2023.1', 'pyarrow>=14', 'pandas>=2', 'emcee>=3.1',
+                 'scikit-learn>=1.3', 'corner>=2.2',
                  'pytest>=7', 'mcap>=1.1', 'mcap-ros2-support>=0.5', 'flake8>=6',
                  'flake8-quotes', 'flake8-import-order', 'flake8-builtins',
                  'flake8-comprehensions', 'flake8-class-newline', 'flake8-blind-except',

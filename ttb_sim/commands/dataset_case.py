@@ -72,7 +72,7 @@ def run_dataset_case(case: DatasetCase) -> dict[str, Any]:
     Never raises for a failing case: the record has ``status`` 'failed' or
     'diverged' and the error message, and no ``case.json`` is written.
     """
-    from ttb_sim.commands.run import run_to_bag
+    from ttb_sim.io.passage import run_to_bag
     from ttb_sim.config import load_scenario
     from ttb_sim.report.output import write_json
     from ttb_sim.sim import Simulation, STEP_BUDGET

@@ -80,7 +80,7 @@ def run_case(spec: CaseSpec) -> dict[str, Any]:
     Never raises for a failing case: the record has ``status`` 'failed' or
     'diverged' and the error message, and no ``case.json`` is written.
     """
-    from ttb_sim.commands.run import run_to_bag
+    from ttb_sim.io.passage import run_to_bag
     from ttb_sim.config import load_scenario
     from ttb_sim.io.streams import load_streams
     from ttb_sim.report.metrics import bag_metrics

@@ -19,12 +19,15 @@ Digital-twin workflows: priors over scenario keys, designs, and the features of 
 - :mod:`ttb_sim.twin.priors` — uniform, normal, lognormal and discrete priors, and the
   Sobol' / Latin-hypercube / random designs that draw cases from them;
 - :mod:`ttb_sim.twin.spec` — the spec of ``ttb-sim dataset``;
-- :mod:`ttb_sim.twin.features` — per-sensor mean, RMS, peak and PSD on a common grid.
+- :mod:`ttb_sim.twin.features` — per-sensor mean, RMS, peak and PSD on a common grid;
+- :mod:`ttb_sim.twin.forward` — a scenario as a function of some keys: ``model(theta)``.
 """
 
 from ttb_sim.twin.features import channel_features, Features, FeatureSpec, sensor_features
+from ttb_sim.twin.forward import FeatureVector, ForwardModel
 from ttb_sim.twin.priors import draw_cases, parse_prior, Prior, SAMPLERS
 from ttb_sim.twin.spec import DatasetSpec, read_spec
 
-__all__ = ['channel_features', 'DatasetSpec', 'draw_cases', 'FeatureSpec', 'Features',
+__all__ = ['channel_features', 'DatasetSpec', 'draw_cases', 'Features', 'FeatureSpec',
+           'FeatureVector', 'ForwardModel',
            'parse_prior', 'Prior', 'read_spec', 'SAMPLERS', 'sensor_features']

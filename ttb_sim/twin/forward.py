@@ -1,0 +1,205 @@
+# Copyright 2026 The ttb_sim Authors
+#
+# Licensed under the Apache License, Version 2.0 (the "License");
+# you may not use this file except in compliance with the License.
+# You may obtain a copy of the License at
+#
+#     http://www.apache.org/licenses/LICENSE-2.0
+#
+# Unless required by applicable law or agreed to in writing, software
+# distributed under the License is distributed on an "AS IS" BASIS,
+# WITHOUT WARRANTIES OR CONDITIONS OF ANY KIND, either express or implied.
+# See the License for the specific language governing permissions and
+# limitations under the License.
+
+
+"""
+The forward model of a twin pipeline: parameters in, a passage's features out.
+
+.. code-block:: python
+
+    from ttb_sim.twin import ForwardModel
+
+    model = ForwardModel('moving_force_beam', ['bridge.bending_stiffness'],
+                         overrides=['sensor_layouts=[span:1]'])
+    x = model([2.0e10])            # the feature vector (numpy), e.g. for sbi or emcee
+    names = model.feature_names    # what each entry is
+
+A case is the scenario with the overrides, then the parameter values (any scenario
+key, indexed list keys included), run to a bag in a scratch folder and reduced to
+its sensors' features by :func:`~ttb_sim.twin.features.sensor_features` — the same
+definition ``ttb-sim dataset`` and ``ttb-sim identify`` use on recorded bags.  What a
+parameter does not change is not rebuilt: the model's compiled kernels stay
+compiled in the process, and the reduced pile-soil operators are cached on disk by
+a hash of their inputs (:mod:`ttb_sim.model.foundation.operator_cache`), so a
+parameter of the girders, bearings, train or environment reuses the substructure's
+basis; a parameter of the soil or piles builds it once per new value.
+
+The feature vector is, per channel (``<sensor>.<axis>``, in the sensors' order),
+log10 of its PSD at the grid points every channel resolves (below the lowest
+sensor Nyquist frequency), then, when asked, its RMS: a log spectrum is what the
+likelihood of :mod:`ttb_sim.twin.identify` treats as Gaussian.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+import logging
+from pathlib import Path
+import tempfile
+from typing import Any, Sequence
+
+import numpy as np
+
+from ttb_sim.errors import ScenarioError, SimulationError
+from ttb_sim.twin.features import Features, FeatureSpec
+
+__all__ = ['FeatureVector', 'ForwardModel']
+
+log = logging.getLogger(__name__)
+
+PSD_FLOOR = 1e-30
+"""Added to a PSD before its logarithm (a channel that reads exactly zero)."""
+
+
+@dataclass(frozen=True)
+class FeatureVector:
+    """Which features make the vector, and their order."""
+
+    channels: tuple[str, ...]
+    """``<sensor>.<axis>`` of each channel, in order."""
+    frequencies_hz: np.ndarray
+    """The PSD grid points kept (every channel resolves them)."""
+    rms: bool = False
+
+    @property
+    def names(self) -> list[str]:
+        """Return the name of each entry: ``log10_psd.<channel>@<f>Hz``, ``rms.<channel>``."""
+        out = [f'log10_psd.{c}@{f:.4g}Hz' for c in self.channels for f in self.frequencies_hz]
+        if self.rms:
+            out += [f'rms.{c}' for c in self.channels]
+        return out
+
+    def of(self, features: Features) -> np.ndarray:
+        """Return the vector of a case's features."""
+        keep = np.isin(features.frequencies_hz, self.frequencies_hz)
+        parts = [np.log10(np.asarray(features.psd[c])[keep] + PSD_FLOOR) for c in self.channels]
+        if self.rms:
+            parts.append(np.array([features.scalars[f'{c}.rms'] for c in self.channels]))
+        return np.concatenate(parts) if parts else np.zeros(0)
+
+
+class ForwardModel:
+    """
+    A scenario as a function of some of its keys: ``model(theta) -> features``.
+
+    Parameters
+    ----------
+    scenario
+        A built-in name or a YAML path.
+    keys
+        The scenario keys ``theta`` sets, in order.
+    overrides
+        ``KEY=VALUE`` strings applied before ``theta``.
+    features
+        The PSD grid and segment length.
+    sensors
+        The names of the sensors whose channels make the vector (default: all).
+    rms
+        Also put each channel's RMS in the vector.
+    storage
+        The scratch bags' storage.
+
+    Raises
+    ------
+    ScenarioError
+        If the scenario, a key or a sensor name is refused, or the scenario has no
+        sensors (checked at once, with the scenario as it is).
+
+    """
+
+    def __init__(self, scenario: str | Path, keys: Sequence[str], *,
+                 overrides: Sequence[str] = (), features: FeatureSpec | None = None,
+                 sensors: Sequence[str] | None = None, rms: bool = False,
+                 storage: str = 'mcap') -> None:
+        from ttb_sim.config import load_scenario
+        self.scenario = str(scenario)
+        self.keys = tuple(keys)
+        self.overrides = tuple(overrides)
+        self.spec = features or FeatureSpec()
+        self.storage = storage
+        base = load_scenario(self.scenario, self.overrides)
+        if base.substructure_only:
+            raise ScenarioError(f'scenario {self.scenario!r} runs the pile-soil substructure '
+                                'alone; a forward model needs passages')
+        self.sensors = _chosen(base.all_sensors, sensors)
+        channels = tuple(f'{s.name}.{a}' for s in self.sensors for a in s.measured_axes)
+        nyquist = min(s.rate_hz / 2.0 for s in self.sensors)
+        grid = self.spec.frequencies()
+        self.vector = FeatureVector(channels, grid[grid <= nyquist], rms)
+        if len(self.vector.names) == 0:
+            raise ScenarioError('the forward model has no features: give features.psd_points '
+                                "> 0 below the sensors' Nyquist frequency, or rms=True")
+        self.evaluations = 0
+
+    @property
+    def feature_names(self) -> list[str]:
+        """Return the name of each entry of the vector."""
+        return self.vector.names
+
+    def values(self, theta: Sequence[float] | np.ndarray) -> list[tuple[str, Any]]:
+        """Return the ``(key, value)`` settings of ``theta``."""
+        theta = np.atleast_1d(np.asarray(theta, dtype=float))
+        if theta.shape != (len(self.keys),):
+            raise ValueError(f'theta has shape {theta.shape}; the model takes '
+                             f'{len(self.keys)} values ({", ".join(self.keys)})')
+        return [(k, float(v)) for k, v in zip(self.keys, theta)]
+
+    def simulate(self, theta: Sequence[float] | np.ndarray, bag: Path | None = None
+                 ) -> Features:
+        """
+        Run one case and return its features; ``bag`` keeps its bag there.
+
+        Raises
+        ------
+        ScenarioError
+            If a value of ``theta`` is refused by the scenario.
+        SimulationError
+            If the run diverged or failed.
+
+        """
+        from ttb_sim.io.passage import run_to_bag
+        from ttb_sim.config import load_scenario
+        from ttb_sim.sim import Simulation
+        from ttb_sim.twin.features import sensor_features
+        scenario = load_scenario(self.scenario, self.overrides, self.values(theta))
+        with tempfile.TemporaryDirectory(prefix='ttb-sim-forward-') as scratch:
+            where = bag if bag is not None else Path(scratch) / 'bag'
+            result = run_to_bag(scenario, where, self.storage, simulation=Simulation(scenario))
+            if result.status != 'ok':
+                raise SimulationError(f'the case {dict(self.values(theta))} {result.status}: '
+                                      f'{result.summary.get("message", "")}')
+            self.evaluations += 1
+            return sensor_features(where, self.sensors, self.spec)
+
+    def __call__(self, theta: Sequence[float] | np.ndarray) -> np.ndarray:
+        """Return the feature vector at ``theta`` (a 2-D ``theta``: one row per case)."""
+        array = np.asarray(theta, dtype=float)
+        if array.ndim == 2:
+            return np.stack([self(row) for row in array])
+        return self.vector.of(self.simulate(array))
+
+
+def _chosen(sensors: Sequence[Any], names: Sequence[str] | None) -> list[Any]:
+    """Return the named sensors (all by default); ScenarioError for an unknown name."""
+    if not sensors:
+        raise ScenarioError('the scenario has no sensors: add a sensors list or '
+                            "sensor_layouts (e.g. --set 'sensor_layouts=[span:1]')")
+    if names is None:
+        return list(sensors)
+    by_name = {s.name: s for s in sensors}
+    unknown = [n for n in names if n not in by_name]
+    if unknown:
+        raise ScenarioError(f'--sensors {",".join(names)}: no sensor {unknown[0]!r} in the '
+                            f'scenario; it has {", ".join(by_name)}')
+    return [by_name[n] for n in names]
