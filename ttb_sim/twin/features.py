@@ -19,7 +19,7 @@ Features of a passage: what a twin pipeline learns from, read off the sensors' r
 Per measured axis of each virtual sensor (topic ``sensors/<name>`` in any namespace,
 so a bag recorded elsewhere with the same topics serves too): the mean, the RMS about
 the mean, the peak (largest magnitude) and the power spectral density on a grid common
-to every sensor and case.  The PSD is Welch's estimate (:func:`scipy.signal.welch`:
+to every sensor and case.  The PSD is Welch's estimate (:func:`ttb_sim.analysis.psd.welch_psd`:
 Hann segments of ``psd_segment_s``, half overlapping, one-sided, unit^2/Hz) interpolated
 onto the grid; grid points above a sensor's Nyquist frequency are NaN.  Lost samples
 (dropouts) are bridged by linear interpolation on the sensor's own sample grid before
@@ -34,6 +34,7 @@ from typing import Sequence
 
 import numpy as np
 
+from ttb_sim.analysis.psd import MIN_SEGMENT_SAMPLES, welch_psd
 from ttb_sim.config.sensor_records import SensorConfig
 from ttb_sim.declarations import param
 from ttb_sim.errors import BagError, ScenarioError
@@ -48,8 +49,8 @@ FIELDS = {'sensor_msgs/msg/Imu': 'linear_acceleration',
 """The field of each sensor message type that holds the measurement."""
 SCALARS = ('mean', 'rms', 'peak')
 """The scalar features of a channel."""
-MIN_SAMPLES = 8
-"""Fewest samples a channel needs for its features."""
+MIN_SAMPLES = MIN_SEGMENT_SAMPLES
+"""Fewest samples a channel needs for its features (one Welch segment)."""
 
 
 @dataclass(frozen=True)
@@ -111,7 +112,6 @@ def channel_features(stamp_s: np.ndarray, values: np.ndarray, rate_hz: float,
         Welch's segment length (shortened to the record).
 
     """
-    from scipy.signal import welch
     if len(values) < MIN_SAMPLES:
         nan = float('nan')
         return {k: nan for k in SCALARS}, np.full(len(frequencies_hz), np.nan)
@@ -123,7 +123,7 @@ def channel_features(stamp_s: np.ndarray, values: np.ndarray, rate_hz: float,
     if len(frequencies_hz) == 0:
         return scalars, np.zeros(0)
     nperseg = int(min(len(regular), max(MIN_SAMPLES, round(segment_s * rate_hz))))
-    f, pxx = welch(regular, fs=rate_hz, nperseg=nperseg, detrend='constant')
+    f, pxx = welch_psd(regular, rate_hz, nperseg / rate_hz)
     psd = np.interp(frequencies_hz, f, pxx)
     psd[frequencies_hz > rate_hz / 2.0] = np.nan
     return scalars, psd

@@ -54,7 +54,7 @@ import numpy as np
 from ttb_sim.errors import ScenarioError, SimulationError
 from ttb_sim.twin.features import Features, FeatureSpec
 
-__all__ = ['FeatureVector', 'ForwardModel']
+__all__ = ['FeatureVector', 'ForwardModel', 'noiseless']
 
 log = logging.getLogger(__name__)
 
@@ -109,6 +109,10 @@ class ForwardModel:
         Also put each channel's RMS in the vector.
     storage
         The scratch bags' storage.
+    noise
+        False: the sensors record without noise, bias, quantisation, clipping or
+        dropouts (their filter, rate and clock kept): the prediction to which a
+        likelihood adds the sensors' noise model (:mod:`ttb_sim.twin.identify`).
 
     Raises
     ------
@@ -121,13 +125,14 @@ class ForwardModel:
     def __init__(self, scenario: str | Path, keys: Sequence[str], *,
                  overrides: Sequence[str] = (), features: FeatureSpec | None = None,
                  sensors: Sequence[str] | None = None, rms: bool = False,
-                 storage: str = 'mcap') -> None:
+                 storage: str = 'mcap', noise: bool = True) -> None:
         from ttb_sim.config import load_scenario
         self.scenario = str(scenario)
         self.keys = tuple(keys)
         self.overrides = tuple(overrides)
         self.spec = features or FeatureSpec()
         self.storage = storage
+        self.noise = noise
         base = load_scenario(self.scenario, self.overrides)
         if base.substructure_only:
             raise ScenarioError(f'scenario {self.scenario!r} runs the pile-soil substructure '
@@ -173,6 +178,8 @@ class ForwardModel:
         from ttb_sim.sim import Simulation
         from ttb_sim.twin.features import sensor_features
         scenario = load_scenario(self.scenario, self.overrides, self.values(theta))
+        if not self.noise:
+            scenario = noiseless(scenario)
         with tempfile.TemporaryDirectory(prefix='ttb-sim-forward-') as scratch:
             where = bag if bag is not None else Path(scratch) / 'bag'
             result = run_to_bag(scenario, where, self.storage, simulation=Simulation(scenario))
@@ -188,6 +195,15 @@ class ForwardModel:
         if array.ndim == 2:
             return np.stack([self(row) for row in array])
         return self.vector.of(self.simulate(array))
+
+
+def noiseless(scenario: Any) -> Any:
+    """Return the scenario with every sensor ideal but for its filter, rate and clock."""
+    import dataclasses
+    ideal = tuple(dataclasses.replace(
+        c, noise_density=0.0, bias=0.0, bias_walk=0.0, resolution=0.0, full_scale=0.0,
+        dropout_probability=0.0) for c in scenario.all_sensors)
+    return dataclasses.replace(scenario, sensors=ideal, sensor_layouts=())
 
 
 def _chosen(sensors: Sequence[Any], names: Sequence[str] | None) -> list[Any]:
