@@ -147,6 +147,10 @@ def _add_bag_verbs(sub: Any) -> None:
     an = sub.add_parser('analyze', help='figures, metrics.json and index.html from a bag')
     an.add_argument('bag', help='bag directory (metadata.yaml + .mcap/.db3) or storage file')
     an.add_argument('--out', type=Path, help='output folder (default: BAG/analysis)')
+    an.add_argument('--modes-window', choices=('free', 'whole'), default='free',
+                    help='records of the modes section (operational modal analysis of the '
+                    "bag's accelerometers): 'free' the free vibration after the last axle has "
+                    "left the bridge (default), 'whole' the whole record (ambient vibration)")
 
     re_ = sub.add_parser(
         'recover', help='rewrite a bag a killed run left (no metadata.yaml, MCAP without '
@@ -290,7 +294,7 @@ def _main(argv: Sequence[str] | None) -> int:
             return validate(args.cases, list_only=args.list)
         if args.command == 'analyze':
             from ttb_sim.commands.analyze import analyze
-            return analyze(args.bag, out=args.out)
+            return analyze(args.bag, out=args.out, modes_window=args.modes_window)
         if args.command == 'recover':
             from ttb_sim.commands.recover import recover
             return recover(args.bag, out=args.out)

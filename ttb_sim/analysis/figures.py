@@ -26,7 +26,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Optional, Sequence
+from typing import Any, Optional, Sequence, TYPE_CHECKING
 
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
@@ -34,8 +34,11 @@ import numpy as np
 
 from ttb_sim.analysis.excitation import Excitation
 
+if TYPE_CHECKING:
+    from ttb_sim.analysis.oma import Identification
+
 __all__ = ['contour_figure', 'grid_figure', 'in_view', 'index_chart', 'IndexValue',
-           'indices_figure', 'Panel', 'panels_figure']
+           'indices_figure', 'Panel', 'panels_figure', 'stabilisation_figure']
 
 Trace = tuple[str, np.ndarray, np.ndarray]
 """(label, x, y) of one line."""
@@ -303,4 +306,49 @@ def indices_figure(path: Path, title: str,
                    rows: Sequence[tuple[str, Sequence[IndexValue], float, str]]) -> Path:
     """Write :func:`index_chart` of the rows to a PNG; return the path written."""
     _save(index_chart(title, rows), path)
+    return path
+
+
+def stabilisation_figure(path: Path, title: str, ident: Identification,
+                         psd: tuple[np.ndarray, np.ndarray],
+                         model_frequencies: Sequence[float] = ()) -> Path:
+    """
+    Write the stabilisation diagram of an identification to a PNG; return the path.
+
+    Poles by model order against frequency (stable ones filled), the identified modes as
+    solid lines, the model's as dashed lines, over the channels' summed PSD (log scale,
+    right axis).
+    """
+    fig = Figure(figsize=(10.0, 5.2))
+    fig.subplots_adjust(left=0.08, right=0.9, bottom=0.11, top=0.86)
+    fig.suptitle(title, fontsize=11)
+    ax = fig.subplots()
+    lo, hi = ident.band_hz
+    unstable = [p for p in ident.poles if not p.stable]
+    stable = [p for p in ident.poles if p.stable]
+    ax.plot([p.frequency_hz for p in unstable], [p.order for p in unstable], 'o', ms=3,
+            mfc='none', color='0.6', label='pole')
+    ax.plot([p.frequency_hz for p in stable], [p.order for p in stable], 'o', ms=4,
+            color='tab:green', label='stable pole (f 1 %, zeta 5 %, MAC 2 %)')
+    for i, m in enumerate(ident.modes):
+        ax.axvline(m.frequency_hz, color='tab:blue', lw=1.2,
+                   label='identified mode' if i == 0 else None)
+        ax.annotate(f'{m.frequency_hz:.3g} Hz\n{100 * m.damping_ratio:.2g} %',
+                    (m.frequency_hz, ident.orders[-1]), textcoords='offset points',
+                    xytext=(3, 4), fontsize=8, color='tab:blue')
+    shown = [f for f in model_frequencies if lo <= f <= hi]
+    for i, f in enumerate(shown):
+        ax.axvline(f, color='tab:red', ls='--', lw=1.0, label='model mode' if i == 0 else None)
+    ax.set_xlim(lo, hi)
+    ax.set_ylim(0, ident.orders[-1] + 6)
+    ax.set_xlabel('frequency (Hz)')
+    ax.set_ylabel('model order')
+    freq, density = psd
+    band = (freq >= lo) & (freq <= hi) & (density > 0)
+    if np.any(band):
+        twin = ax.twinx()
+        twin.semilogy(freq[band], density[band], color='0.3', lw=0.8, alpha=0.7)
+        twin.set_ylabel('summed PSD ((m/s^2)^2/Hz)')
+    ax.legend(loc='lower right', fontsize=8)
+    _save(fig, path)
     return path

@@ -17,7 +17,9 @@
 
 The structure is assembled as ``ttb-sim run`` builds it, without the train;
 piled piers enter monolithically ([P] Eq. 11), so their reduced coordinates
-take part in the modes. For each mode the table gives the frequency, the
+take part in the modes (:func:`ttb_sim.sensors.modal.structure_modes`, which
+``ttb-sim analyze`` shares to set the model's modes beside those it identifies
+from the sensors). For each mode the table gives the frequency, the
 modal damping ratio, the vertical mid-span amplitude of every girder relative
 to the largest, and the vertical pier-top amplitude of every piled pier
 relative to the same girder amplitude: enough to tell a girder's bending mode
@@ -72,19 +74,9 @@ def modes_report(scenario: str | Path, *, around: float = 5.0, count: int = 20,
     from ttb_sim.config import load_scenario
 
     loaded = load_scenario(scenario, overrides)
-    if loaded.substructure_only:
-        raise ScenarioError(f'load.type = {loaded.load.type!r}: {loaded.name} is a pile-soil '
-                            "substructure run without a bridge; allowed: load.type = 'none' "
-                            '(a scenario with a bridge)')
-    if loaded.foundation.model == 'piled':
-        loaded = load_scenario(scenario, [*overrides, 'solver.coupling=monolithic',
-                                          'solver.substructure_steps=1'])
-    from ttb_sim.model.modes import natural_modes
-    from ttb_sim.sim import build_structure
+    from ttb_sim.sensors.modal import structure_modes   # the model: after the options
 
-    structure = build_structure(loaded)
-    found = natural_modes(structure.mass, structure.stiffness, structure.damping, around,
-                          min(count, structure.n_free))
+    structure, found = structure_modes(loaded, around, count)
     ext = np.vstack([found.shapes, np.zeros((1, found.shapes.shape[1]))])
     girders = ext[structure.midspan_dofs[:, 2]]
     tops = {p.support + 1: ext[p.block[2]] for p in structure.piled if p.block is not None}

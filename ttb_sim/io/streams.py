@@ -21,6 +21,9 @@ namespace) and sorts its topics by what they measure.  ``summary.json`` next to
 the bag (written by ``ttb-sim run``) supplies the scenario echo: the car and
 track geometry for excitation frequencies and the observer positions and layer
 properties for power flow.  Without it those figures are skipped with a reason.
+The virtual sensors' topics (``~/sensors/<name>``) are streams by sensor name,
+described by ``summary.json``'s ``sensors`` where it has them; the odometry's
+head position places the train (the free vibration after it has left).
 
 Every stream is a :class:`Series`: times (s) from ``header.stamp`` and values
 (n, 3) in SI units.  Records sampled unevenly (a recorder that dropped
@@ -54,7 +57,12 @@ _PATTERNS = {
     'pier_top': re.compile(r'/piers/pier(\d+)/top$'),
     'observer': re.compile(r'/observers/([^/]+)$'),
     'odometry': re.compile(r'/train/odometry$'),
+    'sensor': re.compile(r'/sensors/([A-Za-z0-9_]+)$'),
 }
+_SENSOR_FIELDS = {'sensor_msgs/msg/Imu': 'linear_acceleration',
+                  'geometry_msgs/msg/WrenchStamped': 'force',
+                  'geometry_msgs/msg/Vector3Stamped': 'vector'}
+"""The field of a sensor topic's message that holds its measured axes (x, y, z)."""
 
 
 @dataclass(frozen=True)
@@ -92,6 +100,14 @@ class Streams:
     """Names of the cloud's points (``pierNN/line_01`` ...) from summary.json; () without."""
     observers: dict[str, Series] = field(default_factory=dict)
     pier_top: dict[int, Series] = field(default_factory=dict)
+    sensors: dict[str, Series] = field(default_factory=dict)
+    """Virtual sensors by name: (n, 3) values on x, y, z (0 on the axes not measured)."""
+    sensor_types: dict[str, str] = field(default_factory=dict)
+    """Message type of each sensor's topic (``sensor_msgs/msg/Imu`` for accelerometers)."""
+    sensor_info: dict[str, dict[str, Any]] = field(default_factory=dict)
+    """Each sensor's entry of ``summary.json``'s ``sensors`` (type, at, axes, ...); {} without."""
+    head_position: Series | None = None
+    """The train head's track position x (m) from the odometry, (n, 1); None without."""
 
     @property
     def duration(self) -> float:
@@ -108,7 +124,8 @@ class Streams:
     def _all(self) -> list[Series]:
         out: list[Series] = []
         for d in (self.car_body, self.wheel_rail, self.midspan, self.bearing,
-                  self.pile_displacement, self.pile_acceleration, self.observers):
+                  self.pile_displacement, self.pile_acceleration, self.observers,
+                  self.sensors):
             out.extend(d.values())
         if self.soil is not None:
             out.append(self.soil)
@@ -186,6 +203,10 @@ def load_streams(path: str | Path, label: str | None = None) -> Streams:
         groups = match.groups()
         if kind == 'odometry' and len(a):
             speeds.append(float(np.median(a['linear_velocity'][:, 0])))
+            out.head_position = _series(a, np.asarray(a['position'][:, :1], dtype=float))
+        elif kind == 'sensor' and a.msgtype in _SENSOR_FIELDS:
+            _put(out.sensors, groups[0], a, a[_SENSOR_FIELDS[a.msgtype]])
+            out.sensor_types[groups[0]] = a.msgtype
         elif kind == 'car_body':
             _put(out.car_body, int(groups[0]), a, a['linear_acceleration'])
             _put(out.car_body_rate, int(groups[0]), a, a['angular_velocity'])
@@ -208,6 +229,10 @@ def load_streams(path: str | Path, label: str | None = None) -> Streams:
             _put(out.observers, groups[0], a, a['vector'])
         elif kind == 'pier_top':
             _put(out.pier_top, int(groups[0]), a, a['vector'])
+    described = summary.get('sensors') if summary else None
+    if isinstance(described, list):
+        out.sensor_info = {str(d['name']): d for d in described
+                           if isinstance(d, dict) and d.get('name') in out.sensors}
     names = summary.get('soil_points') if summary else None
     if (out.soil is not None and isinstance(names, list)
             and len(names) == out.soil.values.shape[1]):
@@ -219,7 +244,7 @@ def load_streams(path: str | Path, label: str | None = None) -> Streams:
     if out.is_empty():
         raise BagError(f'bag {str(bag)!r} has none of the topics analysis reads (car bodies, '
                        'wheel-rail forces, mid-spans, bearings, piles, soil points, '
-                       f'observers); it has: {", ".join(arrays) or "no readable topic"}')
+                       f'observers, sensors); it has: {", ".join(arrays) or "no readable topic"}')
     return out
 
 
