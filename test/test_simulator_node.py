@@ -23,6 +23,7 @@ subscribes to its topics, as ``ros2 param set`` / ``ros2 service call`` would.
 from __future__ import annotations
 
 import functools
+import json
 import math
 import threading
 import time
@@ -45,12 +46,15 @@ from rclpy.parameter import Parameter  # noqa: E402
 from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy  # noqa: E402
 from rosbags.highlevel import AnyReader  # noqa: E402
 from std_srvs.srv import SetBool, Trigger  # noqa: E402
+from ttb_sim.config.labels import LABELS_KEY  # noqa: E402
 from ttb_sim.errors import ScenarioError  # noqa: E402
 from ttb_sim.io.topics import topic_table  # noqa: E402
 from ttb_sim.simulator_node import SimulatorNode  # noqa: E402
+import yaml  # noqa: E402
 from polling import poll_until  # noqa: E402, I100 - the helper in test/
 
 TIMEOUT = 10.0
+LABELS_TOPIC = '/ttb_sim/labels'
 
 
 wait_for = functools.partial(poll_until, timeout=TIMEOUT)
@@ -312,7 +316,7 @@ def test_invalid_start_up_value_raises():
 
 
 def test_bag_holds_every_frame(tmp_path):
-    """The executor, the stepping thread and a sqlite3 bag: every frame recorded."""
+    """The executor, the stepping thread and a sqlite3 bag: every frame, and the labels."""
     path = tmp_path / 'bag'
     h = Harness(scenario='moving_force_beam', real_time_factor=0.0, loop=False,
                 **{'bag.enabled': True, 'bag.path': str(path), 'bag.storage': 'sqlite3'})
@@ -320,13 +324,21 @@ def test_bag_holds_every_frame(tmp_path):
         wait_for(lambda: h.node.controller is not None and h.node.controller.state == 'idle')
         frames = h.node.controller.recorded
         layout = h.node.controller.layout
+        labels = h.node.controller.sensing.labels
     finally:
         h.close()
     with AnyReader([path]) as reader:
         found = {c.topic: c.msgtype for c in reader.connections}
         counts = {c.topic: c.msgcount for c in reader.connections}
-    assert found == {t.full_name(): t.msgtype for t in topic_table(layout)}
-    assert set(counts.values()) == {frames}
+        sent = [json.loads(reader.deserialize(raw, conn.msgtype).data)
+                for conn, _, raw in reader.messages() if conn.topic == LABELS_TOPIC]
+    assert found == {**{t.full_name(): t.msgtype for t in topic_table(layout)},
+                     LABELS_TOPIC: 'std_msgs/msg/String'}
+    assert counts.pop(LABELS_TOPIC) == 1 and set(counts.values()) == {frames}
+    assert sent == [labels] and labels['train']['n_cars'] == 1   # one force: one car
+    metadata = yaml.safe_load((path / 'metadata.yaml').read_text())
+    stored = metadata['rosbag2_bagfile_information']['custom_data'][LABELS_KEY]
+    assert json.loads(stored) == labels                           # as ttb-sim run's bags
 
 
 def test_without_tf2_msgs_the_node_runs_without_tf(monkeypatch):

@@ -24,11 +24,13 @@ import pytest
 from rosbags.highlevel import AnyReader
 from rosbags.typesys import get_typestore, Stores
 from ttb_sim.config import load_scenario, Scenario
+from ttb_sim.config.labels import labels_json, LABELS_KEY
 from ttb_sim.io import read_bag
 from ttb_sim.io.sensor_topics import extra_topics
 from ttb_sim.node.parameters import initial_values, parameter_table
 from ttb_sim.node.passage import PassageController
 from ttb_sim.node.shell import open_bag
+import yaml
 
 SENSORS = ('sensors=[{name: mid, type: accelerometer, at: "girder@16.0", rate_hz: 100, '
            'noise_density: 1.0e-4}, {name: sg, type: strain, at: "girder@8.0", '
@@ -96,6 +98,9 @@ def test_the_node_bag_holds_sensors_and_labels_like_a_run(sensed, tmp_path: Path
                   for conn, _, raw in reader.messages()
                   if conn.topic == '/ttb_sim/labels']
     assert [lab['train']['speed_kmh'] for lab in labels] == [200.0, 250.0]
+    metadata = yaml.safe_load((bag / 'metadata.yaml').read_text())   # the last labels
+    stored = metadata['rosbag2_bagfile_information']['custom_data'][LABELS_KEY]
+    assert stored == labels_json(labels[-1]) and json.loads(stored) == c.sensing.labels
 
 
 def test_without_sensors_nothing_changes(tmp_path: Path):

@@ -167,6 +167,31 @@ def test_labels_in_summary_topic_and_metadata(sensed_bag):
     assert '/ttb_sim/labels' in summary['bag']['topics']
 
 
+@pytest.mark.parametrize('name, sets, cars, axles', [
+    ('moving_force_beam', [], 1, 1),                               # one force by hand
+    ('moving_force_beam', ['train.axle_offsets=[0, 2.5, 17.5]'], 3, 3),   # one car per axle
+    ('ten_span_train', [], 8, 32),                                 # the car layout
+    ('sprung_mass_beam', [], 1, 1),
+    ('live_train', [], 4, 16),
+])
+def test_labels_count_the_cars_the_model_runs(name, sets, cars, axles):
+    """Not ``train.n_cars`` (8 by default): the cars the model carries a passenger load for."""
+    from ttb_sim.config.labels import run_labels
+    from ttb_sim.model.vehicle.train import MovingForces
+    from ttb_sim.sim.build import build_vehicle
+    scenario = load_scenario(name, sets + ['train.passenger_load=1000'])
+    train = run_labels(scenario)['train']
+    assert (train['n_cars'], train['n_axles']) == (cars, axles)
+    vehicle = build_vehicle(scenario)
+    assert vehicle.axles.count == axles
+    t = scenario.train
+    if isinstance(vehicle, MovingForces):   # m g per car, spread over its forces
+        carried = (vehicle.loads.sum() - axles * t.axle_load) / 9.81
+    else:                                   # m per car, spread over its sprung masses
+        carried = vehicle.sprung_mass.sum() - axles * t.sprung_mass
+    assert carried == pytest.approx(cars * 1000.0, rel=1e-3)
+
+
 def test_same_scenario_same_bits(tmp_path, sensed_bag):
     out = tmp_path / 'again'
     assert main(['run', str(scenario_file(tmp_path, SENSORS)), '--out', str(out)]) == 0

@@ -18,18 +18,26 @@ The ground truth of a run, as labels: the state a twin pipeline is asked to reco
 Labels are written to ``summary.json`` (``labels``), to the bag's metadata
 (``custom_data`` key :data:`LABELS_KEY`) and on the latched ``~/labels`` topic: the
 scenario, the damage and environment state (the ``damage`` and ``environment``
-sections, empty when the scenario has none), the train and its speed, the track
-irregularity and every seed.
+sections, empty when the scenario has none), the train (its vehicle model, the
+cars the model runs, :meth:`~ttb_sim.config.records.Scenario.car_count`: one per axle
+when the axles are placed by hand, whatever ``train.n_cars`` says; its axles and its
+speed), the track irregularity and every seed.
+
+Where the labels change during a run (the live node's speed, damage and environment
+parameters), every change is a message of the labels' topic, stamped when it took
+effect; the bag's ``custom_data`` is rewritten at each change and so holds the last
+labels written to the bag (those of its last frames) when it is closed.
 """
 
 from __future__ import annotations
 
-from typing import Any, TYPE_CHECKING
+import json
+from typing import Any, Mapping, TYPE_CHECKING
 
 if TYPE_CHECKING:
     from ttb_sim.config.records import Scenario
 
-__all__ = ['LABELS_KEY', 'run_labels']
+__all__ = ['LABELS_KEY', 'labels_json', 'run_labels']
 
 LABELS_KEY = 'ttb_sim.labels'
 """The key of the labels (JSON) in a bag's ``custom_data``."""
@@ -58,7 +66,8 @@ def run_labels(scenario: Scenario, speed_kmh: float | None = None) -> dict[str, 
         labels['load'] = plain['load']
     else:
         train = plain['train']
-        labels['train'] = {'vehicle': train['vehicle'], 'n_cars': train['n_cars'],
+        labels['train'] = {'vehicle': train['vehicle'], 'n_cars': scenario.car_count(),
+                           'n_axles': len(scenario.axle_positions()),
                            'speed_kmh': train['speed_kmh'] if speed_kmh is None
                            else float(speed_kmh)}
         for key in ('passenger_load',):
@@ -72,3 +81,8 @@ def run_labels(scenario: Scenario, speed_kmh: float | None = None) -> dict[str, 
     labels['seeds'] = {'irregularity': scenario.irregularity.seed,
                        'sensors': {s.name: s.rng_seed for s in scenario.all_sensors}}
     return labels
+
+
+def labels_json(labels: Mapping[str, Any]) -> str:
+    """Return the labels as the JSON text of the bag's ``custom_data`` (keys sorted)."""
+    return json.dumps(labels, sort_keys=True)

@@ -278,6 +278,30 @@ class Scenario:
             return tuple(float(a) for a in self.train.axle_offsets)
         return car_layout(self.train, self.car)
 
+    def axles_per_car(self) -> int:
+        """
+        Return the axles a moving-force or quarter-car model groups into one car.
+
+        The axles of the car layout (``train.axle_offsets`` empty) come four to a car;
+        axles placed by hand each stand for a car of their own. Multibody cars always have
+        the car layout.
+        """
+        train = self.train
+        n = len(self.axle_positions())
+        return n // train.n_cars if not train.axle_offsets and n % train.n_cars == 0 else 1
+
+    def car_count(self) -> int:
+        """
+        Return the number of cars the model runs (the labels' ``n_cars``).
+
+        ``train.n_cars`` for multibody cars and for the car layout; one car per axle when
+        the axles are placed by hand (``train.n_cars`` then plays no part): each carries
+        ``train.passenger_load``, and quarter cars publish one ``train/carNN`` each.
+        """
+        if self.train.vehicle == 'car':
+            return self.train.n_cars
+        return len(self.axle_positions()) // self.axles_per_car()
+
     def to_dict(self) -> dict[str, Any]:
         """Return the scenario as plain nested dicts."""
         return to_plain(dataclasses.asdict(self))

@@ -21,6 +21,9 @@ run computes and returns the samples due (:class:`SensorSample`: extra-topic ind
 stamp, values), which :meth:`SensorStream.message` turns into messages of either
 back-end (rosbags' classes for a bag, rclpy's for the node); the labels are extra
 topic 0, the sensors 1, 2, ... in order (:func:`~ttb_sim.io.sensor_topics.extra_topics`).
+:meth:`SensorStream.write_labels` also stores the labels in the metadata of a sink that
+has metadata (a bag's ``custom_data``, :data:`~ttb_sim.config.labels.LABELS_KEY`), for
+``ttb-sim run`` and the node alike: at each change, so a bag closes with its last labels.
 """
 
 from __future__ import annotations
@@ -30,14 +33,14 @@ from typing import Any, Iterator, Protocol, runtime_checkable, Sequence
 
 import numpy as np
 
-from ttb_sim.config.labels import run_labels
+from ttb_sim.config.labels import labels_json, LABELS_KEY, run_labels
 from ttb_sim.config.records import Scenario
 from ttb_sim.io.sensor_topics import extra_topics, labels_message, sensor_topics, SensorTopic
 from ttb_sim.io.topics import MessageTypes
 from ttb_sim.sensors import Samples, SensorBank
 from ttb_sim.sim import Frame, Layout
 
-__all__ = ['MessageSink', 'SensorSample', 'SensorStream']
+__all__ = ['MessageSink', 'MetadataSink', 'SensorSample', 'SensorStream']
 
 
 @runtime_checkable
@@ -54,6 +57,14 @@ class MessageSink(Protocol):
 
     def write_message(self, index: int, stamp_ns: int, message: Any) -> None:
         """Write one message of the ``index``-th extra topic."""
+
+
+@runtime_checkable
+class MetadataSink(Protocol):
+    """A sink with metadata of its own (a BagRecorder: rosbag2's ``custom_data``)."""
+
+    def set_custom_data(self, key: str, value: str) -> None:
+        """Store ``key: value`` in the metadata (the last value of a key wins)."""
 
 
 @dataclass(frozen=True)
@@ -121,7 +132,15 @@ class SensorStream:
         return self.topics[sample.index - 1].message(types, sample.stamp_ns, sample.xyz)
 
     def write_labels(self, sink: MessageSink, stamp_ns: int) -> None:
-        """Write the labels' message to a sink."""
+        """
+        Write the labels' message to a sink, and the labels to its metadata if it has any.
+
+        The metadata (:data:`~ttb_sim.config.labels.LABELS_KEY`) is overwritten at each
+        call: it holds the labels last written when the sink closes; the history of the
+        labels is the labels' topic.
+        """
+        if isinstance(sink, MetadataSink):
+            sink.set_custom_data(LABELS_KEY, labels_json(self.labels))
         sink.write_message(0, stamp_ns, self.labels_message(sink.types))
 
     def write(self, sink: MessageSink, samples: Sequence[SensorSample]) -> None:

@@ -143,8 +143,7 @@ def build_vehicle(scenario: Scenario) -> Vehicle:
         layout = car_layout(train, scenario.car)
         return MultibodyCars(axles=Axles(offsets=np.asarray(layout, dtype=float)),
                              n_cars=train.n_cars, car_length=train.car_length)
-    # axles of the car layout are published per car; axles placed by hand one per car
-    per_car = n // train.n_cars if not train.axle_offsets and n % train.n_cars == 0 else 1
+    per_car = scenario.axles_per_car()   # four by the car layout, one per axle by hand
     payload = mass_per_axle(train.passenger_load, per_car)  # train.passenger_load
     if train.vehicle == 'moving_force':
         return MovingForces(axles=axles, loads=np.full(n, train.axle_load + payload * GRAVITY))
