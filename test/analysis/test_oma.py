@@ -89,6 +89,8 @@ def test_pairing_by_mac_then_frequency_and_unseen_model_modes():
     assert [p.model for p in pairs] == [0, 2]
     assert pairs[0].frequency_difference == pytest.approx(ident.modes[0].frequency_hz / 5.05 - 1)
     assert pairs[1].mac > 0.99
+    aliased = pair_modes(ident.modes[:1], [ModelMode(10.0, 0.02, MODES[0][2])])
+    assert aliased[0].model is None   # the same shape at twice the frequency: not a pair
     shapeless = pair_modes(ident.modes, [ModelMode(21.5, 0.0), ModelMode(9.0, 0.01)])
     assert [p.model for p in shapeless] == [None, 0]
     assert shapeless[1].damping_difference is None and shapeless[1].mac is None

@@ -34,10 +34,10 @@ against 1 % for SSI-data); SSI-data projects the data themselves and holds for a
 decay and for ambient records alike.
 
 :func:`pair_modes` pairs each identified mode with a model mode (frequency, damping and
-shape at the same channels, e.g. ``ttb-sim modes`` of the structure): the pairs of highest
-MAC first, each model mode used once, a pair only at MAC >= ``min_mac``; where the model
-gives no shape at two channels or more, the nearest frequency within
-:data:`NEAREST_WITHOUT_SHAPE`.
+shape at the same channels, e.g. ``ttb-sim modes`` of the structure) within
+:data:`PAIR_WINDOW` in frequency and of MAC >= ``min_mac``: the one-to-one assignment of
+least total distance 1 - MAC + |ln(f / f_model)|; where the model gives no shape at two
+channels or more, the nearest frequency.
 
 Nothing here reads a bag or builds a model: records in, modes out.
 """
@@ -68,8 +68,12 @@ CLUSTER_DISTANCE = 0.05
 """Average-linkage cut of the pole distance |df| / f + 1 - MAC."""
 HANKEL_COLUMNS_PER_ROW = 2.0
 """The block Hankel matrix has at least this many columns per row (a well-posed projection)."""
-NEAREST_WITHOUT_SHAPE = 0.2
-"""Relative frequency window of a pair made without shapes (no model shape at the channels)."""
+PAIR_WINDOW = 0.2
+"""Relative frequency window of a pair: a few channels cannot tell modes far apart by shape
+(spatial aliasing: four accelerometers on one of ten spans see a 27 Hz mode and a 13 Hz
+one alike, MAC 0.9995), so a pair is sought only within 20 % of the identified frequency."""
+INADMISSIBLE = 1e6
+"""Cost of a pair outside the window or below the least MAC in the assignment."""
 UNSEEN_RATIO = 1e-6
 """A model shape this much smaller at the channels than the largest mode's is not seen."""
 DEFAULT_MAX_ORDER = 40
@@ -161,7 +165,7 @@ class ModePair:
     model: int | None
     """Index into the model modes, or None."""
     mac: float | None
-    """MAC of the pair (None without shapes); unpaired: the best MAC of any model mode."""
+    """MAC of the pair (None without shapes); unpaired: the best MAC within the window."""
     frequency_difference: float | None
     """(f_identified - f_model) / f_model."""
     damping_difference: float | None
@@ -376,32 +380,41 @@ def pair_modes(modes: Sequence[IdentifiedMode], model: Sequence[ModelMode], *,
     """
     Pair identified modes with model modes; return one :class:`ModePair` per identified mode.
 
-    With shapes: every (identified, model) pair of MAC >= ``min_mac`` is a candidate, the
-    highest MAC first, each side used once. Without a model shape at two or more channels:
-    the nearest model frequency within :data:`NEAREST_WITHOUT_SHAPE`.
+    Every (identified, model) pair within :data:`PAIR_WINDOW` in frequency and of MAC >=
+    ``min_mac`` is admissible; of those, the one-to-one assignment of least total modal
+    distance 1 - MAC + |ln(f_identified / f_model)| (the clustering's distance;
+    ``scipy.optimize.linear_sum_assignment``): MAC alone cannot rank the modes of identical
+    spans, which have equal shapes at the channels of one span. Without a model shape at
+    two or more channels: the nearest model frequency within the window.
     """
     def shaped(m: ModelMode) -> bool:
         return m.shape is not None and int(np.sum(np.isfinite(m.shape))) >= MIN_CHANNELS
 
-    macs = np.full((len(modes), len(model)), np.nan)
-    for i, ident in enumerate(modes):
-        for k, mm in enumerate(model):
-            if shaped(mm):
-                assert mm.shape is not None
-                macs[i, k] = mac(ident.shape, mm.shape)
-    taken_i: dict[int, int] = {}
-    used: set[int] = set()
+    def near(i: int, k: int) -> bool:
+        return abs(modes[i].frequency_hz / model[k].frequency_hz - 1.0) <= PAIR_WINDOW
 
     def distance(i: int, k: int) -> float:
         return abs(math.log(modes[i].frequency_hz / model[k].frequency_hz))
 
-    candidates = sorted(((macs[i, k], -distance(i, k), i, k)
-                         for i in range(len(modes)) for k in range(len(model))
-                         if np.isfinite(macs[i, k]) and macs[i, k] >= min_mac), reverse=True)
-    for _, _, i, k in candidates:
-        if i not in taken_i and k not in used:
-            taken_i[i] = k
-            used.add(k)
+    macs = np.full((len(modes), len(model)), np.nan)
+    for i, ident in enumerate(modes):
+        for k, mm in enumerate(model):
+            if shaped(mm) and near(i, k):
+                assert mm.shape is not None
+                macs[i, k] = mac(ident.shape, mm.shape)
+    from scipy.optimize import linear_sum_assignment
+
+    admissible = np.isfinite(macs) & (np.nan_to_num(macs) >= min_mac)
+    cost = np.full(macs.shape, INADMISSIBLE)
+    for i, k in zip(*np.nonzero(admissible)):
+        cost[i, k] = 1.0 - macs[i, k] + distance(int(i), int(k))
+    taken_i: dict[int, int] = {}
+    used: set[int] = set()
+    if cost.size:
+        for i, k in zip(*linear_sum_assignment(cost)):
+            if admissible[i, k]:
+                taken_i[int(i)] = int(k)
+                used.add(int(k))
     for i, ident in enumerate(modes):
         if i in taken_i:
             continue
@@ -409,7 +422,7 @@ def pair_modes(modes: Sequence[IdentifiedMode], model: Sequence[ModelMode], *,
         if not free:
             continue
         k = min(free, key=lambda k: distance(i, k))
-        if abs(ident.frequency_hz / model[k].frequency_hz - 1.0) <= NEAREST_WITHOUT_SHAPE:
+        if near(i, k):
             taken_i[i] = k
             used.add(k)
     out = []

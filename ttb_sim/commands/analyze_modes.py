@@ -155,24 +155,25 @@ def _window(records: Records, s: Streams, scenario: Scenario | None, why: str,
                      'train_exit_s': exit_time, 'margin_s': FREE_MARGIN_S if exit_time else 0.0}
 
 
-def _model(scenario: Scenario | None, source: str, records: Records,
+def _model(scenario: Scenario | None, source: str, records: Records, ident: Identification,
            highest_hz: float) -> tuple[list[ModelMode] | None, dict[str, Any]]:
     """Return the model's modes at the channels and their description (None and why)."""
     if scenario is None:
         return None, {'reason': f'{source}: the model modes are not computed'}
-    from ttb_sim.sensors.modal import channel_shapes, MAX_MODEL_MODES, modes_below
+    from ttb_sim.sensors.modal import channel_modes, FIRST_COUNT, NEAR_COUNT
 
     try:
-        structure, found = modes_below(scenario, highest_hz)
-        shapes = channel_shapes(structure, found, [(c.place, c.axis) for c in records.channels])
+        structure, found, shapes = channel_modes(
+            scenario, [(c.place, c.axis) for c in records.channels],
+            [m.frequency_hz for m in ident.modes], highest_hz)
     except (TtbSimError, ValueError) as exc:
         return None, {'reason': f'the model of {scenario.name} cannot be solved: {exc}'}
-    model = [ModelMode(float(f), float(z), shapes[:, k])
-             for k, (f, z) in enumerate(zip(found.frequencies, found.damping_ratios))]
-    model = unit_shapes(model)
+    model = unit_shapes([ModelMode(float(f), float(z), shapes[:, k]) for k, (f, z)
+                         in enumerate(zip(found.frequencies, found.damping_ratios))])
     about = {'scenario': scenario.name, 'source': f'{source}, built and solved as ttb-sim '
-             'modes does', 'free_dofs': structure.n_free,
-             'highest_hz': highest_hz, 'modes_at_most': MAX_MODEL_MODES,
+             'modes does', 'free_dofs': structure.n_free, 'highest_hz': highest_hz,
+             'modes': f'the {FIRST_COUNT} lowest and the {NEAR_COUNT} nearest each '
+             'identified frequency, up to highest_hz',
              'channels_with_shape': int(np.sum(np.any(np.isfinite(shapes), axis=1)))
              if shapes.size else 0}
     return model, about
@@ -211,7 +212,7 @@ def modes_section(s: Streams, window: str = 'free') -> ModesSection:
     except IdentificationError as exc:
         return _skipped(f"{about['kind']} window t = {about['start_s']:.3f}.."
                         f"{about['end_s']:.3f} s: {exc}")
-    model, model_about = _model(scenario, why, records, highest)
+    model, model_about = _model(scenario, why, records, ident, highest)
     pairs = pair_modes(ident.modes, model or [])
     metrics = modes_metrics(ident, records, about, model, pairs, model_about)
     if not ident.modes:

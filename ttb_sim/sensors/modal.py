@@ -42,14 +42,15 @@ if TYPE_CHECKING:
     from ttb_sim.config import Scenario
     from ttb_sim.model.structure import Structure
 
-__all__ = ['channel_shapes', 'MAX_MODEL_MODES', 'modes_below', 'structure_modes']
+__all__ = ['channel_modes', 'channel_shapes', 'modal_structure', 'modes_near', 'monolithic',
+           'solve', 'structure_modes']
 
 log = logging.getLogger(__name__)
 
-MAX_MODEL_MODES = 60
-"""Most model modes :func:`modes_below` computes (a big model's track modes crowd the band)."""
 FIRST_COUNT = 24
-"""Modes asked for first by :func:`modes_below`, doubled until the band is covered."""
+"""The lowest model modes :func:`modes_near` lists."""
+NEAR_COUNT = 12
+"""Model modes :func:`modes_near` takes nearest each identified frequency."""
 
 
 def monolithic(scenario: Scenario) -> Scenario:
@@ -58,6 +59,29 @@ def monolithic(scenario: Scenario) -> Scenario:
         return scenario
     solver = dataclasses.replace(scenario.solver, coupling='monolithic', substructure_steps=1)
     return dataclasses.replace(scenario, solver=solver)
+
+
+def modal_structure(scenario: Scenario) -> Structure:
+    """
+    Build the structure ``ttb-sim modes`` solves: as a run builds it, piled piers monolithic.
+
+    Raises
+    ------
+    ScenarioError
+        For a substructure run without a bridge.
+
+    """
+    if scenario.substructure_only:
+        raise ScenarioError(f'load.type = {scenario.load.type!r}: {scenario.name} is a '
+                            'pile-soil substructure run without a bridge; allowed: load.type '
+                            "= 'none' (a scenario with a bridge)")
+    return build_structure(monolithic(scenario))
+
+
+def solve(structure: Structure, around: float, count: int) -> Modes:
+    """Return the structure's ``count`` modes nearest ``around`` Hz."""
+    return natural_modes(structure.mass, structure.stiffness, structure.damping, around,
+                         min(count, structure.n_free))
 
 
 def structure_modes(scenario: Scenario, around: float, count: int) -> tuple[Structure, Modes]:
@@ -70,31 +94,33 @@ def structure_modes(scenario: Scenario, around: float, count: int) -> tuple[Stru
         For a substructure run without a bridge.
 
     """
-    if scenario.substructure_only:
-        raise ScenarioError(f'load.type = {scenario.load.type!r}: {scenario.name} is a '
-                            'pile-soil substructure run without a bridge; allowed: load.type '
-                            "= 'none' (a scenario with a bridge)")
-    structure = build_structure(monolithic(scenario))
-    found = natural_modes(structure.mass, structure.stiffness, structure.damping, around,
-                          min(count, structure.n_free))
-    return structure, found
+    structure = modal_structure(scenario)
+    return structure, solve(structure, around, count)
 
 
-def modes_below(scenario: Scenario, highest_hz: float) -> tuple[Structure, Modes]:
-    """Return the structure and its lowest modes up to ``highest_hz`` (at most MAX_MODEL_MODES)."""
-    count = FIRST_COUNT
-    while True:
-        structure, found = structure_modes(scenario, 0.0, count)
-        covered = found.frequencies.size and found.frequencies.max() >= highest_hz
-        if covered or count >= MAX_MODEL_MODES or found.frequencies.size >= structure.n_free:
-            break
-        count = min(2 * count, MAX_MODEL_MODES)
-    keep = found.frequencies <= highest_hz
-    if not covered:
-        log.info('the %d lowest model modes reach %.3g Hz, below %.3g Hz', found.frequencies.size,
-                 float(found.frequencies.max()), highest_hz)
-    return structure, Modes(found.frequencies[keep], found.damping_ratios[keep],
-                            found.shapes[:, keep])
+def modes_near(scenario: Scenario, frequencies: Sequence[float],
+               highest_hz: float) -> tuple[Structure, Modes]:
+    """
+    Return the structure and its modes to set beside identified ones, up to ``highest_hz``.
+
+    The :data:`FIRST_COUNT` lowest modes and the :data:`NEAR_COUNT` nearest each of
+    ``frequencies`` (shift-invert about each: a long bridge has hundreds of modes below
+    the band's top, and the ones near an identified mode are those to compare), in
+    increasing frequency, each once.
+    """
+    structure = modal_structure(scenario)
+    parts = [solve(structure, 0.0, FIRST_COUNT)]
+    parts += [solve(structure, float(f), NEAR_COUNT) for f in frequencies]
+    f = np.concatenate([m.frequencies for m in parts])
+    zeta = np.concatenate([m.damping_ratios for m in parts])
+    shapes = np.hstack([m.shapes for m in parts])
+    order = np.argsort(f, kind='stable')
+    keep = [int(order[0])] if order.size else []
+    for k in order[1:]:   # the same mode found twice: equal frequency to round-off
+        if not np.isclose(f[k], f[keep[-1]], rtol=1e-9, atol=1e-12):
+            keep.append(int(k))
+    keep = [k for k in keep if f[k] <= highest_hz]
+    return structure, Modes(f[keep], zeta[keep], shapes[:, keep])
 
 
 def channel_shapes(structure: Structure, modes: Modes,
@@ -121,3 +147,11 @@ def channel_shapes(structure: Structure, modes: Modes,
             continue
         out[c] = rows.rows[0, AXIS[axis]] @ ext[rows.dofs[0]]
     return out
+
+
+def channel_modes(scenario: Scenario, channels: Sequence[tuple[str, str]],
+                  frequencies: Sequence[float],
+                  highest_hz: float) -> tuple[Structure, Modes, np.ndarray]:
+    """Return :func:`modes_near` and the modes' values at the channels (:func:`channel_shapes`)."""
+    structure, found = modes_near(scenario, frequencies, highest_hz)
+    return structure, found, channel_shapes(structure, found, channels)
