@@ -205,6 +205,34 @@ def _add_bag_verbs(sub: Any) -> None:
                        "tcp://host:8786 (pip install 'ttb_sim[dask]')")
     ds.add_argument('--force', action='store_true', help='run cases above the step budget')
 
+    idn = sub.add_parser('identify', help='Bayesian updating of scenario keys from a recorded '
+                         'passage (emcee on a surrogate of the model; docs/twin.md)')
+    idn.add_argument('bag', help='bag directory (its sensors/<name> topics are the data)')
+    idn.add_argument('--param', dest='params', action='append', default=[],
+                     metavar='KEY=FAMILY:A,B', help='a key to update and its prior: '
+                     'uniform:A,B, normal:MEAN,SD or lognormal:MU,SIGMA; repeatable')
+    idn.add_argument('--scenario', help="the model to update (default: the bag's own)")
+    idn.add_argument('--set', dest='overrides', action='append', default=[],
+                     metavar='KEY=VALUE', help='override a key of the model; repeatable')
+    idn.add_argument('--out', type=Path, help='output folder (default: BAG/identify)')
+    idn.add_argument('--sensors', help='comma-separated sensor names (default: every sensor '
+                     'of the model recorded in the bag)')
+    idn.add_argument('--design', type=int, default=0, help='forward runs of the surrogate '
+                     '(default 8 d + 8)')
+    idn.add_argument('--steps', type=int, default=3000, help='MCMC steps (default 3000)')
+    idn.add_argument('--walkers', type=int, default=0, help='MCMC walkers (default max(16, 4 d))')
+    idn.add_argument('--seed', type=int, default=0, help='seed of the design and the sampler')
+    idn.add_argument('--discrepancy', type=float, default=0.02, help='model discrepancy in '
+                     'log10 PSD (default 0.02, about 5 %%)')
+    idn.add_argument('--response', default='passage', choices=('passage', 'ambient'),
+                     help='what scatters in the data: the sensor noise over a deterministic '
+                     'passage (default), or an ambient random response too')
+    idn.add_argument('--fmin', type=float, help='lowest PSD frequency (default 1 / segment)')
+    idn.add_argument('--fmax', type=float, help='highest (default 0.8 x the lowest sensor '
+                     'Nyquist frequency)')
+    idn.add_argument('--points', type=int, default=48, help='PSD grid points (default 48)')
+    idn.add_argument('--segment', type=float, help='Welch segment, s (default min(2, record/4))')
+
     sc = sub.add_parser('scenarios', help='list the built-in scenarios')
     sc.add_argument('--keys', action='store_true',
                     help='list every scenario key with unit, default and range')
@@ -311,6 +339,14 @@ def _main(argv: Sequence[str] | None) -> int:
             from ttb_sim.commands.dataset import dataset
             return dataset(args.spec, out=args.out, n=args.n, workers=args.workers,
                            scheduler=args.scheduler, force=args.force)
+        if args.command == 'identify':
+            from ttb_sim.commands.identify import identify_command
+            return identify_command(args.bag, args.params, out=args.out, scenario=args.scenario,
+                                    overrides=args.overrides, sensors=args.sensors,
+                                    design=args.design, steps=args.steps, walkers=args.walkers,
+                                    seed=args.seed, discrepancy=args.discrepancy,
+                                    fmin=args.fmin, fmax=args.fmax, points=args.points,
+                                    segment=args.segment, response=args.response)
         if args.command == 'bench':
             from ttb_sim.commands.bench import bench_command
             return bench_command(args.scenarios, variants=args.variants,

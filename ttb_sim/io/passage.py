@@ -102,7 +102,6 @@ def run_to_bag(scenario: Scenario, out: str | Path, storage: str = 'mcap',
         Re-raised after the bag and summary have been closed and written.
 
     """
-    from ttb_sim.config.labels import LABELS_KEY
     from ttb_sim.io.bag import BagRecorder, check_destination, make_parents
     from ttb_sim.io.sensor_stream import SensorStream
     from ttb_sim.io.topics import NAMESPACE, PeakTracker, topic_table
@@ -122,7 +121,6 @@ def run_to_bag(scenario: Scenario, out: str | Path, storage: str = 'mcap',
     start = time.perf_counter()
     try:
         with BagRecorder(out, topics, storage, extra=sensing.extra) as bag:
-            bag.set_custom_data(LABELS_KEY, json.dumps(sensing.labels, sort_keys=True))
             bag.set_custom_data(SCENARIO_KEY, json.dumps(scenario.echo(), sort_keys=True))
             sensing.write_labels(bag, 0)
             try:

@@ -41,7 +41,7 @@ from ttb_sim.errors import BagError, ScenarioError
 from ttb_sim.io.reader import bag_topics, read_bag
 from ttb_sim.io.sensor_topics import SensorTopic
 
-__all__ = ['channel_features', 'FeatureSpec', 'Features', 'sensor_features']
+__all__ = ['channel_features', 'FeatureSpec', 'Features', 'record_length', 'sensor_features']
 
 FIELDS = {'sensor_msgs/msg/Imu': 'linear_acceleration',
           'geometry_msgs/msg/WrenchStamped': 'force',
@@ -162,6 +162,23 @@ def sensor_features(bag: str | Path, sensors: Sequence[SensorConfig],
             if len(grid):
                 psd[channel] = channel_psd
     return Features(scalars, psd, grid)
+
+
+def record_length(bag: str | Path, sensors: Sequence[SensorConfig]) -> float:
+    """
+    Return the shortest span of the sensors' records in a bag (s).
+
+    Raises
+    ------
+    BagError
+        If a sensor's topic is missing, or no sensor recorded two samples.
+
+    """
+    arrays = read_bag(bag, [SensorTopic(c, 0.0).name for c in sensors])
+    spans = [float(a.stamp[-1] - a.stamp[0]) for a in arrays.values() if len(a) > 1]
+    if not spans:
+        raise BagError(f'bag {str(bag)!r}: the sensors recorded fewer than two samples each')
+    return min(spans)
 
 
 def _is(absolute: str, relative: str) -> bool:

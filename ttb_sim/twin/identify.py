@@ -30,8 +30,11 @@ with ideal sensors, and the link between them the sensors' own noise model:
   one more real run.
 - **Likelihood.** log10 of Welch's estimate of P over K half-overlapping segments
   scatters about log10 P with a standard deviation of
-  sqrt(2 S N + N^2) / (P sqrt(K) ln 10) (deterministic passage response plus white
-  noise); a model discrepancy (``discrepancy``, log10 units) is added in quadrature.
+  sqrt(2 S N + N^2) / (P sqrt(K) ln 10) for a passage (``response='passage'``: the
+  response to the train is deterministic, only the sensor noise is random), or
+  1 / (sqrt(K) ln 10) for an ambient record (``response='ambient'``: the response
+  itself is a random process, chi-square with 2K degrees of freedom); a model
+  discrepancy (``discrepancy``, log10 units) is added in quadrature.
   Grid points closer than two Welch bins (2 / segment) are thinned out, so the points
   used are nearly independent; grid points a channel does not resolve are dropped.
 - **Sampler.** emcee's affine-invariant ensemble on the priors' probability scale
@@ -55,15 +58,18 @@ import numpy as np
 
 from ttb_sim.config.sensor_records import SensorConfig
 from ttb_sim.errors import ScenarioError, SimulationError, TtbSimError
-from ttb_sim.twin.features import Features
+from ttb_sim.twin.features import Features, FeatureSpec
 from ttb_sim.twin.forward import ForwardModel
 from ttb_sim.twin.priors import Prior, unit_design
 
-__all__ = ['Identification', 'identify', 'IdentifySettings', 'Observation', 'Surrogate']
+__all__ = ['data_grid', 'Identification', 'identify', 'IdentifySettings', 'Observation',
+           'Surrogate']
 
 log = logging.getLogger(__name__)
 
 LN10 = math.log(10.0)
+RESPONSES = ('passage', 'ambient')
+"""What scatters in the data: the sensor noise alone, or the response too."""
 CONVERGED_TAUS = 50.0
 """A chain at least this many autocorrelation times long is called converged."""
 
@@ -81,6 +87,8 @@ class IdentifySettings:
     discrepancy: float = 0.02
     """Model discrepancy, log10 units (0.02: about 5 % in the PSD)."""
     flat_ratio: float = 0.7
+    response: str = 'passage'
+    """'passage' (deterministic response plus sensor noise) or 'ambient' (random response)."""
 
     def __post_init__(self) -> None:
         """Refuse settings that cannot run."""
@@ -92,8 +100,36 @@ class IdentifySettings:
         if not (0.0 <= self.discrepancy <= 10.0):
             raise ScenarioError(f'--discrepancy {self.discrepancy!r} must be in [0, 10] '
                                 '(log10 units)')
+        if self.response not in RESPONSES:
+            raise ScenarioError(f'--response {self.response!r}: allowed {", ".join(RESPONSES)}')
         if not (0.0 < self.flat_ratio <= 1.0):
             raise ScenarioError(f'flat_ratio {self.flat_ratio!r} must be in (0, 1]')
+
+
+def data_grid(record_s: float, sensors: Sequence[SensorConfig], *, fmin: float | None = None,
+              fmax: float | None = None, points: int = 48, segment: float | None = None
+              ) -> FeatureSpec:
+    """
+    Return the PSD grid of the data.
+
+    By default: segments of min(2 s, record / 4) (seven half-overlapping ones at
+    least), from one bin (1 / segment) to 0.8 of the lowest Nyquist frequency (the
+    anti-alias filter's flat band).
+
+    Raises
+    ------
+    ScenarioError
+        For a grid the arguments make empty or out of range (naming the option).
+
+    """
+    from ttb_sim.config.schema import from_mapping
+    seg = segment if segment is not None else min(2.0, record_s / 4.0)
+    nyquist = min(s.rate_hz for s in sensors) / 2.0
+    grid = {'psd_fmin_hz': fmin if fmin is not None else 1.0 / seg,
+            'psd_fmax_hz': fmax if fmax is not None else 0.8 * nyquist,
+            'psd_points': points, 'psd_segment_s': seg}
+    spec: FeatureSpec = from_mapping(grid, FeatureSpec, 'features.')
+    return spec
 
 
 def noise_psd(config: SensorConfig) -> float:
@@ -143,8 +179,10 @@ class Observation:
         s = 10.0 ** model_vectors[..., self.used]
         return np.log10(s + self.noise)
 
-    def measurement_sd(self, predicted: np.ndarray) -> np.ndarray:
+    def measurement_sd(self, predicted: np.ndarray, response: str = 'passage') -> np.ndarray:
         """Return the sd of log10 Welch estimates about ``predicted`` log10 P (rows)."""
+        if response == 'ambient':
+            return np.full(predicted.shape, 1.0 / (math.sqrt(self.segments) * LN10))
         p = 10.0 ** predicted
         s = np.clip(p - self.noise, 0.0, None)
         spread = np.sqrt(2.0 * s * self.noise + self.noise ** 2)
@@ -217,6 +255,8 @@ class Identification:
     check: dict[str, Any] = field(default_factory=dict)
     failed_design: list[str] = field(default_factory=list)
     settings: IdentifySettings = field(default_factory=IdentifySettings)
+    median_z: np.ndarray | None = None
+    """log10(S + N) of a real run at the posterior median, at the features used."""
 
     def summary(self) -> dict[str, Any]:
         """Return posterior.json's contents: per key median, q05, q95, ..., and diagnostics."""
@@ -235,6 +275,7 @@ class Identification:
             'surrogate_cv_rmse_log10': {'median': float(np.median(self.surrogate_cv_rmse)),
                                         'max': float(np.max(self.surrogate_cv_rmse))},
             'discrepancy_log10': self.settings.discrepancy,
+            'response': self.settings.response,
             'seed': self.settings.seed},
             'check_at_median': self.check}
         u_samples = np.column_stack([_cdf(p, self.samples[:, j])
@@ -338,7 +379,7 @@ def identify(model: ForwardModel, priors: Sequence[Prior], observed: Features,
         out = np.full(len(u), -np.inf)
         if inside.any():
             mean, sd = surrogate.predict(u[inside])
-            var = observation.measurement_sd(mean) ** 2 + sd ** 2 + floor
+            var = observation.measurement_sd(mean, settings.response) ** 2 + sd ** 2 + floor
             out[inside] = -0.5 * np.sum((y - mean) ** 2 / var + np.log(2 * np.pi * var),
                                         axis=1)
         return out
@@ -362,23 +403,24 @@ def identify(model: ForwardModel, priors: Sequence[Prior], observed: Features,
                             float(np.mean(sampler.acceptance_fraction)), np.asarray(tau),
                             burn, thin, design_theta, z, observation, surrogate.cv_rmse,
                             failed_design=failed, settings=settings)
-    result.check = _check_median(model, priors, observation, surrogate, samples)
+    result.check, result.median_z = _check_median(model, priors, observation, surrogate, samples)
     return result
 
 
 def _check_median(model: ForwardModel, priors: Sequence[Prior], observation: Observation,
-                  surrogate: Surrogate, samples: np.ndarray) -> dict[str, Any]:
+                  surrogate: Surrogate, samples: np.ndarray
+                  ) -> tuple[dict[str, Any], np.ndarray | None]:
     """Run the model at the posterior median: how far the surrogate was, and the data."""
     median = np.median(samples, axis=0)
     try:
         z = observation.observable(model(median))
     except TtbSimError as exc:
-        return {'theta': dict(model.values(median)), 'error': str(exc)}
+        return {'theta': dict(model.values(median)), 'error': str(exc)}, None
     u = np.array([[float(_cdf(p, np.array([m]))[0]) for p, m in zip(priors, median)]])
     predicted, _ = surrogate.predict(u)
     return {'theta': dict(model.values(median)),
             'rms_run_vs_data_log10': float(np.sqrt(np.mean((z - observation.log_psd) ** 2))),
-            'rms_run_vs_surrogate_log10': float(np.sqrt(np.mean((z - predicted[0]) ** 2)))}
+            'rms_run_vs_surrogate_log10': float(np.sqrt(np.mean((z - predicted[0]) ** 2)))}, z
 
 
 def _shown(keys: Sequence[str], theta: np.ndarray) -> str:

@@ -42,6 +42,7 @@ from ttb_sim.validation.cases.sensors import SENSOR_CASES
 from ttb_sim.validation.cases.slab_plate import SLAB_PLATE_CASES
 from ttb_sim.validation.cases.system import SYSTEM_CASES
 from ttb_sim.validation.cases.track import TRACK_CASES
+from ttb_sim.validation.cases.twin import TWIN_CASES
 from ttb_sim.validation.references.structural import (Beam, fryba_peak, QuarterCar,
                                                       sprung_mass_modal)
 from ttb_sim.validation.rows import Case, relative_row, Row
@@ -174,7 +175,7 @@ CASES: dict[str, Case] = {c.case_id: c for c in sorted((
     Case('V7', 'Newmark average acceleration: order and energy', _v7),
     *COMPONENT_CASES, *SLAB_PLATE_CASES, *SYSTEM_CASES, *TRACK_CASES, *PILE_SOIL_CASES,
     *PILE_GROUP_CASES, *ANALYSIS_CASES, *COUPLED_CASES, *DAMAGE_CASES, *SENSOR_CASES,
-    *CONDITION_CASES, *MODAL_CASES),
+    *CONDITION_CASES, *MODAL_CASES, *TWIN_CASES),
     key=lambda c: (c.case_id[0] != 'V', int(c.case_id[1:])))}
 """Cases by id: V* are VALIDATION.md's, X* are extra checks of modelling choices."""
 
