@@ -53,6 +53,7 @@ from dataclasses import dataclass, field
 import logging
 import math
 from typing import Any, Callable, Sequence
+import warnings
 
 import numpy as np
 
@@ -202,6 +203,7 @@ class Surrogate:
     """A Gaussian process over the probability-scale design: u -> log10(S + N)."""
 
     def __init__(self, u: np.ndarray, z: np.ndarray, seed: int) -> None:
+        from sklearn.exceptions import ConvergenceWarning
         from sklearn.gaussian_process import GaussianProcessRegressor
         from sklearn.gaussian_process.kernels import ConstantKernel, RBF, WhiteKernel
         d = u.shape[1]
@@ -209,7 +211,14 @@ class Surrogate:
             WhiteKernel(1e-4, (1e-10, 1e-1))
         self.gp = GaussianProcessRegressor(kernel, normalize_y=True, n_restarts_optimizer=3,
                                            random_state=seed)
-        self.gp.fit(u, z)
+        with warnings.catch_warnings(record=True) as caught:
+            # A length scale at its upper bound is the GP's way of saying the features do
+            # not depend on that key: the flat posterior reports it, the warning would not.
+            warnings.simplefilter('always', ConvergenceWarning)
+            self.gp.fit(u, z)
+        for w in caught:
+            quiet = issubclass(w.category, ConvergenceWarning)
+            log.log(logging.DEBUG if quiet else logging.WARNING, 'surrogate fit: %s', w.message)
         self.cv_rmse = self._cross_validated(u, z)
 
     def _cross_validated(self, u: np.ndarray, z: np.ndarray, folds: int = 5) -> np.ndarray:
