@@ -206,7 +206,8 @@ def load_streams(path: str | Path, label: str | None = None) -> Streams:
             out.head_position = _series(a, np.asarray(a['position'][:, :1], dtype=float))
         elif kind == 'sensor' and a.msgtype in _SENSOR_FIELDS:
             _put(out.sensors, groups[0], a, a[_SENSOR_FIELDS[a.msgtype]])
-            out.sensor_types[groups[0]] = a.msgtype
+            if groups[0] in out.sensors:   # a topic with no messages has no series
+                out.sensor_types[groups[0]] = a.msgtype
         elif kind == 'car_body':
             _put(out.car_body, int(groups[0]), a, a['linear_acceleration'])
             _put(out.car_body_rate, int(groups[0]), a, a['angular_velocity'])
