@@ -60,8 +60,10 @@ setup(
         # MIT), its surrogate (scikit-learn's Gaussian process, BSD), its corner plot (corner,
         # BSD)
         'twin': ['pyarrow>=14', 'emcee>=3.1', 'scikit-learn>=1.3', 'corner>=2.2'],
+        # operational modal analysis in analyze: SSI of strid (MIT)
+        'oma': ['strid>=0.4'],
         'test': ['dask[distributed]>=2023.1', 'pyarrow>=14', 'pandas>=2', 'emcee>=3.1',
-                 'scikit-learn>=1.3', 'corner>=2.2',
+                 'scikit-learn>=1.3', 'corner>=2.2', 'strid>=0.4',
                  'pytest>=7', 'mcap>=1.1', 'mcap-ros2-support>=0.5', 'flake8>=6',
                  'flake8-quotes', 'flake8-import-order', 'flake8-builtins',
                  'flake8-comprehensions', 'flake8-class-newline', 'flake8-blind-except',
