@@ -19,7 +19,7 @@ The ``identify`` verb: Bayesian updating of scenario keys from a recorded passag
 ``ttb-sim identify BAG --param KEY=uniform:A,B [--param ...] --out DIR
 [--scenario SCENARIO] [--set KEY=VALUE ...] [--sensors a,b] [--design N] [--steps N]
 [--walkers N] [--seed N] [--discrepancy X] [--fmin HZ] [--fmax HZ] [--points N]
-[--segment S] [--workers N | --scheduler ADDRESS]``
+[--segment S]``
 
 The model to update is ``--scenario`` (with ``--set``), or by default the scenario the
 bag was recorded from (stored in its metadata by ``ttb-sim run``; a bag recorded
@@ -29,11 +29,6 @@ is :mod:`ttb_sim.twin.identify`.  ``DIR`` receives ``posterior.json`` (per key
 ``median``, ``q05``, ``q95``, ``identified`` and the diagnostics), ``chains.npz``,
 ``corner.png``, ``trace.png``, ``fit.png`` and ``index.html``; it is written whole
 at the end (nothing half-written on an error or a signal).
-
-The design runs go to local worker processes (``--workers``, default one per core,
-at most one per run) or a Dask cluster (``--scheduler``) through
-:mod:`ttb_sim.commands.pool`, the way ``dataset`` runs its cases; the posterior is
-the same bit for bit whatever runs them.
 """
 
 from __future__ import annotations
@@ -42,7 +37,7 @@ from pathlib import Path
 import re
 import sys
 import time
-from typing import Any, Callable, Sequence
+from typing import Any, Sequence
 
 import numpy as np
 
@@ -95,12 +90,10 @@ def identify_command(bag: str | Path, params: Sequence[str], *, out: str | Path 
                      sensors: str | None = None, design: int = 0, steps: int = 3000,
                      walkers: int = 0, seed: int = 0, discrepancy: float = 0.02,
                      fmin: float | None = None, fmax: float | None = None, points: int = 48,
-                     segment: float | None = None, response: str = 'passage',
-                     workers: int | None = None, scheduler: str | None = None) -> int:
-    """Run ``ttb-sim identify``; return the exit code (128 + signal when stopped)."""
-    from ttb_sim.commands.pool import check_workers
-    from ttb_sim.commands.signals import signal_name, Stopped
+                     segment: float | None = None, response: str = 'passage') -> int:
+    """Run ``ttb-sim identify``; return the exit code."""
     from ttb_sim.io.bag_checks import check_bag_path
+    from ttb_sim.report.output import staged_output
     from ttb_sim.twin.identify import IdentifySettings
     start = time.perf_counter()
     path = Path(bag)
@@ -112,59 +105,12 @@ def identify_command(bag: str | Path, params: Sequence[str], *, out: str | Path 
     keys = [p.key for p in priors]
     if len(set(keys)) != len(keys):
         raise ScenarioError(f'--param names a key twice ({", ".join(keys)})')
-    check_workers(workers, scheduler)
     settings = IdentifySettings(design=design, walkers=walkers, steps=steps, seed=seed,
                                 discrepancy=discrepancy, response=response)
     check_bag_path(path)
     target = Path(out) if out is not None else \
         (path if path.is_dir() else path.parent) / 'identify'
     _check_out(target)
-    try:
-        summary = _identify(path, target, settings, priors, keys, scenario, overrides, sensors,
-                            fmin, fmax, points, segment, pool_evaluate(workers, scheduler), start)
-    except Stopped as stop:
-        print(f'ttb-sim: stopped by {signal_name(stop.signum)}; nothing written to {target}',
-              file=sys.stderr)
-        return 128 + stop.signum
-    _report(target, summary)
-    return EXIT_OK
-
-
-def pool_evaluate(workers: int | None, scheduler: str | None) -> Callable[..., None]:
-    """
-    Return the design's evaluator on local workers or Dask (``--workers``, ``--scheduler``).
-
-    Each design run is a :class:`~ttb_sim.twin.forward.DesignRun` mapped over
-    :func:`~ttb_sim.twin.forward.run_design` by :func:`~ttb_sim.commands.pool.run_cases`;
-    a signal stops the workers and raises :class:`~ttb_sim.commands.signals.Stopped`.
-    """
-    from ttb_sim.commands.pool import make_pool, run_cases
-    from ttb_sim.twin.forward import DesignRun, Done, ForwardModel, run_design
-
-    def lost(case: DesignRun, error: BaseException) -> dict[str, Any]:
-        return {'status': 'failed', 'error': f'worker lost: {type(error).__name__}: {error}'}
-
-    def evaluate(model: ForwardModel, thetas: np.ndarray, done: Done) -> None:
-        cases = [DesignRun(f'design{i:04d}', i, model, tuple(float(v) for v in theta))
-                 for i, theta in enumerate(thetas)]
-        pool = make_pool(run_design, len(cases), workers, scheduler)
-
-        def record(case: DesignRun, rec: dict[str, Any]) -> None:
-            done(case.index, rec['vector'] if rec['status'] == 'ok' else rec['error'],
-                 rec.get('wall_time_s') or 0.0)
-        stop = run_cases(pool, cases, lost, 'identify', record, lines=False)
-        if stop is not None:
-            raise stop
-    return evaluate
-
-
-def _identify(path: Path, target: Path, settings: Any, priors: Sequence[Any],
-              keys: Sequence[str], scenario: str | None, overrides: Sequence[str],
-              sensors: str | None, fmin: float | None, fmax: float | None, points: int,
-              segment: float | None, evaluate: Callable[..., None], start: float
-              ) -> dict[str, Any]:
-    """Set up, identify and write the staged output; return the summary."""
-    from ttb_sim.report.output import staged_output
     with staged_output(target) as stage:
         model, observed, record = _set_up(path, stage, scenario, overrides, keys, sensors,
                                           fmin, fmax, points, segment, priors)
@@ -174,8 +120,7 @@ def _identify(path: Path, target: Path, settings: Any, priors: Sequence[Any],
         from ttb_sim.twin.identify import identify
         result = identify(model, priors, observed, record, settings,
                           progress=lambda line: print(f'ttb-sim: identify: {line}',
-                                                      file=sys.stderr, flush=True),
-                          evaluate=evaluate)
+                                                      file=sys.stderr, flush=True))
         summary = result.summary()
         summary.update(bag=str(path), scenario=model.scenario, overrides=list(model.overrides),
                        sensors=[s.name for s in model.sensors],
@@ -186,7 +131,8 @@ def _identify(path: Path, target: Path, settings: Any, priors: Sequence[Any],
                                  'segment_s': model.spec.psd_segment_s},
                        wall_time_s=time.perf_counter() - start)
         _write(stage, path, result, summary)
-    return summary
+    _report(target, summary)
+    return EXIT_OK
 
 
 def _check_out(target: Path) -> None:

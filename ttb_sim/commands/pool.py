@@ -182,12 +182,11 @@ def make_pool(run: Callable[[Case], Record], n_cases: int, workers: int | None,
 
 def run_cases(pool: LocalPool[Case] | DaskPool[Case], cases: Sequence[Case],
               lost: Callable[[Case, BaseException], Record], verb: str,
-              on_record: Callable[[Case, Record], None], lines: bool = True) -> Stopped | None:
+              on_record: Callable[[Case, Record], None]) -> Stopped | None:
     """
     Run the cases on the pool, handing each record to ``on_record`` as it comes.
 
-    Prints a progress line per case to stderr (``[3/20] case ok in 12.5 s``) unless
-    ``lines`` is False (``on_record`` then prints its own).
+    Prints a progress line per case to stderr (``[3/20] case ok in 12.5 s``).
     Returns the :class:`Stopped` of a SIGINT/SIGTERM (the pool is then stopped),
     or None when every case came back.
     """
@@ -203,8 +202,6 @@ def run_cases(pool: LocalPool[Case] | DaskPool[Case], cases: Sequence[Case],
         for i, (case, outcome) in enumerate(pool.results(), start=1):
             record = lost(case, outcome) if isinstance(outcome, BaseException) else outcome
             on_record(case, record)
-            if not lines:
-                continue
             detail = f'in {record.get("wall_time_s", 0.0) or 0.0:.1f} s' \
                 if record['status'] == 'ok' else f'{record["status"]}: {record.get("error")}'
             print(f'ttb-sim: {verb}: [{i}/{len(cases)}] {case.name} {record["status"]} '

@@ -39,13 +39,6 @@ The feature vector is, per channel (``<sensor>.<axis>``, in the sensors' order),
 log10 of its PSD at the grid points every channel resolves (below the lowest
 sensor Nyquist frequency), then, when asked, its RMS: a log spectrum is what the
 likelihood of :mod:`ttb_sim.twin.identify` treats as Gaussian.
-
-Many cases at once: :func:`evaluate_in_process` runs them one after the other;
-:class:`DesignRun` and :func:`run_design` are the picklable case and the top-level
-function a process pool or a Dask cluster maps over them (``ttb-sim identify
---workers N`` does, through :mod:`ttb_sim.commands.pool`).  Either way a case's
-vector depends on its ``theta`` alone, so the results are the same bit for bit
-whatever runs them.
 """
 
 from __future__ import annotations
@@ -54,16 +47,14 @@ from dataclasses import dataclass
 import logging
 from pathlib import Path
 import tempfile
-import time
-from typing import Any, Callable, Sequence
+from typing import Any, Sequence
 
 import numpy as np
 
-from ttb_sim.errors import ScenarioError, SimulationError, TtbSimError
+from ttb_sim.errors import ScenarioError, SimulationError
 from ttb_sim.twin.features import Features, FeatureSpec
 
-__all__ = ['DesignRun', 'Done', 'Evaluate', 'evaluate_in_process', 'FeatureVector',
-           'ForwardModel', 'noiseless', 'run_design']
+__all__ = ['FeatureVector', 'ForwardModel', 'noiseless']
 
 log = logging.getLogger(__name__)
 
@@ -204,45 +195,6 @@ class ForwardModel:
         if array.ndim == 2:
             return np.stack([self(row) for row in array])
         return self.vector.of(self.simulate(array))
-
-
-Done = Callable[[int, 'np.ndarray | str', float], None]
-"""Called as each case finishes: its index, its vector (or the error of a failed run), wall s."""
-Evaluate = Callable[['ForwardModel', np.ndarray, Done], None]
-"""Runs ``model`` at each row of ``thetas``, calling ``done`` once per case, in any order."""
-
-
-@dataclass(frozen=True)
-class DesignRun:
-    """One case of many: the model and its ``theta`` (picklable, for a worker process)."""
-
-    name: str
-    index: int
-    model: ForwardModel
-    theta: tuple[float, ...]
-
-
-def run_design(case: DesignRun) -> dict[str, Any]:
-    """
-    Run one case; return its record: ``status`` ('ok' or 'failed'), ``vector`` or ``error``.
-
-    A refused or diverged case (:class:`~ttb_sim.errors.TtbSimError`) is a record,
-    never an exception; ``wall_time_s`` is the run's.
-    """
-    start = time.perf_counter()
-    try:
-        vector = case.model(np.array(case.theta))
-    except TtbSimError as exc:
-        return {'status': 'failed', 'error': str(exc), 'wall_time_s': time.perf_counter() - start}
-    return {'status': 'ok', 'vector': vector, 'wall_time_s': time.perf_counter() - start}
-
-
-def evaluate_in_process(model: ForwardModel, thetas: np.ndarray, done: Done) -> None:
-    """Run the cases one after the other in this process (the default :data:`Evaluate`)."""
-    for i, theta in enumerate(np.atleast_2d(thetas)):
-        record = run_design(DesignRun(f'case{i:05d}', i, model, tuple(float(v) for v in theta)))
-        done(i, record['vector'] if record['status'] == 'ok' else record['error'],
-             record['wall_time_s'])
 
 
 def noiseless(scenario: Any) -> Any:

@@ -60,7 +60,7 @@ import numpy as np
 from ttb_sim.config.sensor_records import SensorConfig
 from ttb_sim.errors import ScenarioError, SimulationError, TtbSimError
 from ttb_sim.twin.features import Features, FeatureSpec
-from ttb_sim.twin.forward import Evaluate, evaluate_in_process, ForwardModel
+from ttb_sim.twin.forward import ForwardModel
 from ttb_sim.twin.priors import Prior, unit_design
 
 __all__ = ['data_grid', 'Identification', 'identify', 'IdentifySettings', 'Observation',
@@ -321,8 +321,7 @@ def _cdf(prior: Prior, values: np.ndarray) -> np.ndarray:
 
 def identify(model: ForwardModel, priors: Sequence[Prior], observed: Features,
              record_s: float, settings: IdentifySettings | None = None,
-             progress: Callable[[str], None] | None = None,
-             evaluate: Evaluate | None = None) -> Identification:
+             progress: Callable[[str], None] | None = None) -> Identification:
     """
     Update the priors of ``model``'s keys from a recorded passage's features.
 
@@ -339,12 +338,7 @@ def identify(model: ForwardModel, priors: Sequence[Prior], observed: Features,
     settings
         Design size, sampler, seed, discrepancy.
     progress
-        Called with one line per design run, as each finishes.
-    evaluate
-        Runs the design (default :func:`~ttb_sim.twin.forward.evaluate_in_process`,
-        one run after the other); ``ttb-sim identify --workers N`` passes one that
-        maps :func:`~ttb_sim.twin.forward.run_design` over a process pool.  The runs
-        are put back in design order, so the result does not depend on it.
+        Called with one line per design run.
 
     Raises
     ------
@@ -366,26 +360,18 @@ def identify(model: ForwardModel, priors: Sequence[Prior], observed: Features,
     observation = Observation.of(model, observed, record_s)
     n_design = settings.design or 8 * d + 8
     u_design = unit_design(n_design, d, 'sobol', settings.seed)
-    design = np.array([[p.quantile(np.array([x]))[0] for p, x in zip(priors, u)]
-                       for u in u_design])
-    outcomes: dict[int, np.ndarray | str] = {}
-
-    def done(i: int, outcome: np.ndarray | str, wall_s: float) -> None:
-        outcomes[i] = outcome
-        if progress is not None:
-            status = 'failed' if isinstance(outcome, str) else f'ok in {wall_s:.1f} s'
-            progress(f'design run {len(outcomes)}/{n_design} at '
-                     f'{_shown(model.keys, design[i])}: {status}')
-
-    (evaluate or evaluate_in_process)(model, design, done)
     thetas, vectors, failed = [], [], []
-    for i, theta in enumerate(design):   # in design order: the same whatever ran them
-        outcome = outcomes.get(i, 'no result')
-        if isinstance(outcome, str):   # a case refused or diverged: recorded, the others go on
-            failed.append(f'{_shown(model.keys, theta)}: {outcome}')
-        else:
+    for i, u in enumerate(u_design):
+        theta = np.array([p.quantile(np.array([x]))[0] for p, x in zip(priors, u)])
+        outcome = 'ok'
+        try:
+            vectors.append(model(theta))
             thetas.append(theta)
-            vectors.append(outcome)
+        except TtbSimError as exc:   # a case refused or diverged: recorded, the others go on
+            failed.append(f'{_shown(model.keys, theta)}: {exc}')
+            outcome = 'failed'
+        if progress is not None:
+            progress(f'design run {i + 1}/{n_design} at {_shown(model.keys, theta)}: {outcome}')
     if len(thetas) < d + 3:
         raise SimulationError(f'only {len(thetas)} of {n_design} design runs succeeded (at '
                               f'least {d + 3} needed): {"; ".join(failed[:3])}')
