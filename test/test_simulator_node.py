@@ -46,8 +46,10 @@ from rclpy.parameter import Parameter  # noqa: E402
 from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy  # noqa: E402
 from rosbags.highlevel import AnyReader  # noqa: E402
 from std_srvs.srv import SetBool, Trigger  # noqa: E402
+from ttb_sim.config import from_mapping  # noqa: E402
 from ttb_sim.config.labels import LABELS_KEY  # noqa: E402
 from ttb_sim.errors import ScenarioError  # noqa: E402
+from ttb_sim.io.passage import recorded_scenario  # noqa: E402
 from ttb_sim.io.topics import topic_table  # noqa: E402
 from ttb_sim.simulator_node import SimulatorNode  # noqa: E402
 import yaml  # noqa: E402
@@ -316,7 +318,7 @@ def test_invalid_start_up_value_raises():
 
 
 def test_bag_holds_every_frame(tmp_path):
-    """The executor, the stepping thread and a sqlite3 bag: every frame, and the labels."""
+    """The executor, the stepping thread and a sqlite3 bag: every frame, labels, scenario."""
     path = tmp_path / 'bag'
     h = Harness(scenario='moving_force_beam', real_time_factor=0.0, loop=False,
                 **{'bag.enabled': True, 'bag.path': str(path), 'bag.storage': 'sqlite3'})
@@ -325,6 +327,7 @@ def test_bag_holds_every_frame(tmp_path):
         frames = h.node.controller.recorded
         layout = h.node.controller.layout
         labels = h.node.controller.sensing.labels
+        scenario = h.node.controller.passage_scenario()
     finally:
         h.close()
     with AnyReader([path]) as reader:
@@ -339,6 +342,7 @@ def test_bag_holds_every_frame(tmp_path):
     metadata = yaml.safe_load((path / 'metadata.yaml').read_text())
     stored = metadata['rosbag2_bagfile_information']['custom_data'][LABELS_KEY]
     assert json.loads(stored) == labels                           # as ttb-sim run's bags
+    assert from_mapping(recorded_scenario(path)) == scenario      # identify's model
 
 
 def test_without_tf2_msgs_the_node_runs_without_tf(monkeypatch):

@@ -23,9 +23,10 @@ import numpy as np
 import pytest
 from rosbags.highlevel import AnyReader
 from rosbags.typesys import get_typestore, Stores
-from ttb_sim.config import load_scenario, Scenario
+from ttb_sim.config import from_mapping, load_scenario, Scenario
 from ttb_sim.config.labels import labels_json, LABELS_KEY
 from ttb_sim.io import read_bag
+from ttb_sim.io.passage import recorded_scenario
 from ttb_sim.io.sensor_topics import extra_topics
 from ttb_sim.node.parameters import initial_values, parameter_table
 from ttb_sim.node.passage import PassageController
@@ -101,6 +102,10 @@ def test_the_node_bag_holds_sensors_and_labels_like_a_run(sensed, tmp_path: Path
     metadata = yaml.safe_load((bag / 'metadata.yaml').read_text())   # the last labels
     stored = metadata['rosbag2_bagfile_information']['custom_data'][LABELS_KEY]
     assert stored == labels_json(labels[-1]) and json.loads(stored) == c.sensing.labels
+    # and the scenario it last ran, as ttb-sim run's bags: identify rebuilds the model
+    scenario = from_mapping(recorded_scenario(bag))
+    assert scenario == c.passage_scenario() and scenario.train.speed_kmh == 250.0
+    assert scenario.all_sensors == sensed.all_sensors
 
 
 def test_without_sensors_nothing_changes(tmp_path: Path):

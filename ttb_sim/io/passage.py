@@ -36,10 +36,11 @@ from ttb_sim.errors import SimulationError
 
 if TYPE_CHECKING:
     from ttb_sim.config import Scenario
+    from ttb_sim.io.sensor_stream import MetadataSink
     from ttb_sim.io.topics import PeakTracker, Topic
     from ttb_sim.sim import CostEstimate, Runner
 
-__all__ = ['recorded_scenario', 'RunResult', 'run_to_bag', 'SCENARIO_KEY']
+__all__ = ['recorded_scenario', 'RunResult', 'run_to_bag', 'SCENARIO_KEY', 'store_scenario']
 
 SCENARIO_KEY = 'ttb_sim.scenario'
 """The key of the run's scenario (JSON, as ``summary.json`` echoes it) in a bag's
@@ -121,7 +122,7 @@ def run_to_bag(scenario: Scenario, out: str | Path, storage: str = 'mcap',
     start = time.perf_counter()
     try:
         with BagRecorder(out, topics, storage, extra=sensing.extra) as bag:
-            bag.set_custom_data(SCENARIO_KEY, json.dumps(scenario.echo(), sort_keys=True))
+            store_scenario(bag, scenario)
             sensing.write_labels(bag, 0)
             try:
                 for frame in sim.frames():
@@ -189,6 +190,16 @@ def _summary(scenario: Scenario, sim: Runner, out: Path, storage: str, topics: S
         'peaks': peaks.summary(),
         'soil_points': list(sim.layout.soil_point_names),
     }
+
+
+def store_scenario(sink: MetadataSink, scenario: Scenario) -> None:
+    """
+    Store ``scenario`` in a bag's ``custom_data`` (:data:`SCENARIO_KEY`), as JSON.
+
+    What :func:`recorded_scenario` reads back.  ``ttb-sim run`` stores it once; the
+    node again whenever the scenario of its passage changes (the last value wins).
+    """
+    sink.set_custom_data(SCENARIO_KEY, json.dumps(scenario.echo(), sort_keys=True))
 
 
 def recorded_scenario(bag: str | Path) -> dict[str, Any] | None:

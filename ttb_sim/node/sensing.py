@@ -18,7 +18,10 @@ The virtual sensors and ground-truth labels of the live node's passages.
 :class:`LiveSensing` keeps one :class:`~ttb_sim.io.sensor_stream.SensorStream` over the
 passages of a node (built with the first, again only when the frame rate changes, so a
 sensor's noise, filter state and clock run on across passages), takes each passage's
-labels, and writes samples and labels to a recorder that takes messages. A writer
+labels, and writes samples and labels to a recorder that takes messages; with the
+labels, a recorder that has metadata (a bag) also gets the scenario of the passage
+(:func:`~ttb_sim.io.passage.store_scenario`, as ``ttb-sim run`` stores it), so
+``ttb-sim identify`` rebuilds the model from the node's bag. A writer
 that fails hands its exception to the caller's ``on_error`` (recording stops; the
 stepping does not).
 """
@@ -29,7 +32,8 @@ import logging
 from typing import Callable
 
 from ttb_sim.config import Scenario
-from ttb_sim.io.sensor_stream import MessageSink, SensorSample, SensorStream
+from ttb_sim.io.passage import store_scenario
+from ttb_sim.io.sensor_stream import MessageSink, MetadataSink, SensorSample, SensorStream
 from ttb_sim.sim import Frame, Layout
 
 __all__ = ['LiveSensing']
@@ -49,6 +53,8 @@ class LiveSensing:
         self._rate = 0.0
         self.labels_due = False
         """True when the labels changed since they were last emitted."""
+        self.scenario: Scenario | None = None
+        """The scenario of the passage (as last relabelled)."""
 
     @property
     def samples_every_frame(self) -> bool:
@@ -70,6 +76,7 @@ class LiveSensing:
         if self.stream is None:
             return
         self.stream.relabel(scenario)
+        self.scenario = scenario
         self.labels_due = True
 
     def push(self, frame: Frame) -> list[SensorSample]:
@@ -95,6 +102,8 @@ class LiveSensing:
         """
         Write changed labels to ``sink`` (if it takes messages) at ``stamp_ns``.
 
+        A sink with metadata also stores the passage's scenario (and the labels).
+
         Returns
         -------
         bool
@@ -105,10 +114,12 @@ class LiveSensing:
         if not self.labels_due or stream is None:
             return False
         self.labels_due = False
-        if stream.takes(sink):
-            assert isinstance(sink, MessageSink)
-            try:
+        try:
+            if isinstance(sink, MetadataSink) and self.scenario is not None:
+                store_scenario(sink, self.scenario)
+            if stream.takes(sink):
+                assert isinstance(sink, MessageSink)
                 stream.write_labels(sink, stamp_ns)
-            except Exception as exc:  # noqa: B902 - any writer failure stops recording only
-                on_error(exc)
+        except Exception as exc:  # noqa: B902 - any writer failure stops recording only
+            on_error(exc)
         return True
