@@ -47,7 +47,8 @@ def test_pier_layout_names_piles_geophones_and_settlement():
     s = load_scenario('paper_ttbcpsi', ['sensor_layouts=[pier:7]'])
     names = [c.name for c in s.all_sensors]
     assert names == ['pier07_pile05_acc', 'pier07_pile08_acc', 'pier07_pile14_acc',
-                     'pier07_geo_1', 'pier07_geo_2', 'pier07_geo_3', 'pier07_settlement']
+                     'pier07_geo_1', 'pier07_geo_2', 'pier07_geo_3', 'pier07_settlement',
+                     'pier07_top_acc']
 
 
 @pytest.mark.parametrize('entry, message', [

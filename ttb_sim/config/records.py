@@ -38,7 +38,7 @@ from typing import Any
 from ttb_sim.config.observers import Observer, parse_observers
 from ttb_sim.config.schema import to_plain
 from ttb_sim.config.sensor_layouts import expand_layouts
-from ttb_sim.config.sensor_places import check_places, on_girders
+from ttb_sim.config.sensor_places import check_places, gauge_of, on_girders
 from ttb_sim.config.sensor_records import decimation_factor, SensorConfig, SensorError
 from ttb_sim.declarations import param
 from ttb_sim.errors import ScenarioError
@@ -374,8 +374,34 @@ def _check_sensors(s: Scenario) -> None:
             check_places(sensor)
             if s.output.rate_hz > 0:
                 decimation_factor(s.output.rate_hz, sensor)
+            _check_gauge(s, sensor)
         except SensorError as exc:
             raise ScenarioError(f'{where}: {exc}') from None
+    if sensors and s.substructure_only and s.load.type == 'static':
+        raise ScenarioError("sensors: a static load (load.type = 'static') gives one frame, "
+                            'nothing a sensor can sample; use load.type harmonic or pulse, or '
+                            'read the frame (no sensors)')
+
+
+def _check_gauge(s: Scenario, sensor: SensorConfig) -> None:
+    """Refuse a pile strain gauge off the scenario's piles (pier, pile number, depth)."""
+    gauge = gauge_of(sensor)
+    if gauge is None:
+        return
+    piled = (1,) if s.substructure_only else (
+        tuple(s.foundation.piled_piers) if s.foundation.model == 'piled' else ())
+    what = f'{sensor.name}: at = {sensor.at!r}'
+    if gauge.pier not in piled:
+        raise SensorError(f'{what}: pier {gauge.pier} has no piles; piled piers: '
+                          f'{list(piled)} (foundation.piled_piers; a substructure alone is '
+                          'pier01)')
+    count = s.piles.rows * s.piles.cols
+    if not 1 <= gauge.pile <= count:
+        raise SensorError(f'{what}: pile {gauge.pile} does not exist; the group has {count} '
+                          f'(1 to {count}, piles.rows x piles.cols)')
+    if gauge.depth > s.piles.length:
+        raise SensorError(f'{what}: depth {gauge.depth:g} m is below the pile tip; allowed 0 '
+                          f'to {s.piles.length:g} m (piles.length)')
 
 
 def _check_girder(s: Scenario) -> None:

@@ -24,7 +24,8 @@ start with the kind and the number, with the specifications of common hardware
   inclinometer at each end and, where the girder rests on a pier, a bearing LVDT
   (girder end relative to the pier top);
 - ``pier:N`` — piled pier N: pile-head accelerometers on [P]'s piles #5 and #14 and the
-  central pile, geophones at [P]'s three VAL ground points, the pier top's settlement;
+  central pile, geophones at [P]'s three VAL ground points, the pier top's settlement and
+  a triaxial accelerometer on the pier top (the pier cap's vibration);
 - ``wheelset:N`` — car N: its first axle instrumented (both wheels, three force axes).
 """
 
@@ -139,6 +140,8 @@ def _pier(n: int, grid: tuple[int, int]) -> list[dict[str, Any]]:
     items += [{**GEOPHONE, 'name': f'pier{n:02d}_geo_{k}', 'at': f'ground/pier{n:02d}/val_{k}'}
               for k in (1, 2, 3)]
     items.append({**LEVEL, 'name': f'pier{n:02d}_settlement', 'at': f'pier{n:02d}/top'})
+    items.append({**ACCELEROMETER, 'name': f'pier{n:02d}_top_acc', 'at': f'pier{n:02d}/top',
+                  'axes': 'xyz'})
     return items
 
 

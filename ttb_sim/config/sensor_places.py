@@ -16,7 +16,9 @@
 The places a sensor may be, parsed: locations of ``at`` and ``relative_to``, and the probes.
 
 Sensors on a pile head, a pier top, a car body, a wheel or a ground point read
-values every frame holds already. Sensors on a beam line (girder, rails, slab,
+values every frame holds already; pile strain gauges read the pile's axial strain
+at their depth, which the runners evaluate for the gauges asked for
+(:func:`gauge_requests`). Sensors on a beam line (girder, rails, slab,
 base plates) read *probes*: rows of the line's element interpolation applied to
 the structure's displacement, velocity or acceleration, or to its derivative
 along the beam (rotation; fibre strain u' - z w'' - y v'' at the fibre (y, z)),
@@ -32,19 +34,20 @@ from typing import Any, Sequence
 
 from ttb_sim.config.sensor_records import LOCATION_FORMS, SensorConfig, SensorError
 
-__all__ = ['ALLOWED_PLACES', 'check_places', 'Location', 'on_girders', 'parse_location',
-           'probe_requests', 'ProbeRequest']
+__all__ = ['ALLOWED_PLACES', 'check_places', 'gauge_requests', 'GaugeRequest', 'Location',
+           'on_girders', 'parse_location', 'probe_requests', 'ProbeRequest']
 
 AXIS = {'x': 0, 'y': 1, 'z': 2}
 
 ALLOWED_PLACES = {
     'accelerometer': {'line': 'acceleration', 'car': 'body_acceleration',
-                      'pile': 'pile_acceleration', 'ground': 'acceleration'},
+                      'pile': 'pile_acceleration', 'pier_top': 'pier_top_acceleration',
+                      'ground': 'acceleration'},
     'displacement': {'line': 'displacement', 'pile': 'pile_displacement',
                      'pier_top': 'pier_tops', 'ground': 'displacement'},
     'inclinometer': {'line': 'rotation'},
     'geophone': {'line': 'velocity', 'ground': 'velocity'},
-    'strain': {'line': 'strain'},
+    'strain': {'line': 'strain', 'pile': 'pile_strain'},
     'wheel_force': {'wheel': 'wheel_rail'},
 }
 """Per sensor type: the kinds of location it may be at, and what it reads there."""
@@ -65,6 +68,11 @@ class Location:
         """Track position of a beam-line point (m)."""
         return float(self.parts[1])
 
+    @property
+    def depth(self) -> float:
+        """Depth of a pile point below the pile head (m; 0: at the head)."""
+        return float(self.parts[2]) if self.kind == 'pile' and self.parts[2] else 0.0
+
 
 @dataclass(frozen=True)
 class ProbeRequest:
@@ -81,6 +89,18 @@ class ProbeRequest:
     """The (y, z) offset of the point from the beam axis (m): the strain gauge's fibre."""
 
 
+@dataclass(frozen=True)
+class GaugeRequest:
+    """A pile strain gauge the runner evaluates at every frame: the pile's axial strain."""
+
+    pier: int
+    """Pier number (1-based support)."""
+    pile: int
+    """Pile number in the group (1-based)."""
+    depth: float
+    """Depth below the pile head (m)."""
+
+
 def parse_location(text: str, what: str) -> Location:
     """
     Parse a location string (``girder@208``, ``car03``, ``pier07/pile05`` ...).
@@ -94,20 +114,30 @@ def parse_location(text: str, what: str) -> Location:
     for kind, form in LOCATION_FORMS.items():
         match = form.match(text.strip())
         if match:
-            location = Location(kind, match.groups())
+            location = Location(kind, tuple(g or '' for g in match.groups()))
             if kind in ('line', 'span'):
-                try:
-                    x = float(location.parts[1])
-                except ValueError:
-                    x = math.nan
-                if not math.isfinite(x):
-                    raise SensorError(f'{what} = {text!r}: position {location.parts[1]!r} is '
-                                      'not a finite number (m)')
+                _number(what, text, location.parts[1], 'position')
+            if kind == 'pile' and location.parts[2] and not _number(
+                    what, text, location.parts[2], 'depth') >= 0.0:
+                raise SensorError(f'{what} = {text!r}: depth {location.parts[2]!r} is above '
+                                  'the pile head; allowed: 0 to the pile length (m below it)')
             return location
     raise SensorError(f"{what} = {text!r}: allowed forms are 'spanNN/x=X' (X m from the "
                       "span's left support), 'girder@x' (x along the track; or rail_left, "
                       "rail_right, slab, base), 'carNN', 'carNN/axleK/left|right', "
-                      "'pierNN/pileMM', 'pierNN/top', 'ground/pierNN/<point>'")
+                      "'pierNN/pileMM', 'pierNN/pileMM/depth=D' (strain), 'pierNN/top', "
+                      "'ground/pierNN/<point>'")
+
+
+def _number(what: str, text: str, part: str, name: str) -> float:
+    """Return ``part`` as a finite float, or raise naming the location."""
+    try:
+        value = float(part)
+    except ValueError:
+        value = math.nan
+    if not math.isfinite(value):
+        raise SensorError(f'{what} = {text!r}: {name} {part!r} is not a finite number (m)')
+    return value
 
 
 def on_girders(config: SensorConfig, span_length: float, n_spans: int) -> SensorConfig:
@@ -163,10 +193,14 @@ def check_places(config: SensorConfig) -> None:
             raise SensorError(f'{config.name}: a {config.type} cannot be at {text!r} (a '
                               f'{location.kind.replace("_", " ")}); allowed: '
                               f'{", ".join(_FORM_NAMES[k] for k in places)}')
+        if location.kind == 'pile' and location.parts[2] and config.type != 'strain':
+            raise SensorError(f'{config.name}: {key} = {text!r}: a {config.type} reads the '
+                              "pile head ('pierNN/pileMM'); only a strain gauge may be at a "
+                              "depth ('pierNN/pileMM/depth=D')")
 
 
 _FORM_NAMES = {'line': 'girder@x (rail_left, rail_right, slab, base)', 'car': 'carNN',
-               'wheel': 'carNN/axleK/left|right', 'pile': 'pierNN/pileMM',
+               'wheel': 'carNN/axleK/left|right', 'pile': 'pierNN/pileMM[/depth=D]',
                'pier_top': 'pierNN/top', 'ground': 'ground/pierNN/<point>'}
 
 
@@ -189,4 +223,22 @@ def probe_requests(sensors: Sequence[SensorConfig]) -> tuple[ProbeRequest, ...]:
             request = request_of(config, text) if text else None
             if request is not None and request not in out:
                 out.append(request)
+    return tuple(out)
+
+
+def gauge_of(config: SensorConfig) -> GaugeRequest | None:
+    """Return the pile strain gauge a sensor reads (None unless a strain gauge on a pile)."""
+    location = parse_location(config.at, config.name)
+    if config.type != 'strain' or location.kind != 'pile':
+        return None
+    return GaugeRequest(int(location.parts[0]), int(location.parts[1]), location.depth)
+
+
+def gauge_requests(sensors: Sequence[SensorConfig]) -> tuple[GaugeRequest, ...]:
+    """Return the distinct pile strain gauges the sensors read, in first-use order."""
+    out: list[GaugeRequest] = []
+    for config in sensors:
+        request = gauge_of(config)
+        if request is not None and request not in out:
+            out.append(request)
     return tuple(out)

@@ -54,19 +54,21 @@ LOCATION_FORMS = {
     'span': re.compile(r'^span(\d+)/x=(.+)$'),
     'car': re.compile(r'^car(\d+)$'),
     'wheel': re.compile(r'^car(\d+)/axle(\d+)/(left|right)$'),
-    'pile': re.compile(r'^pier(\d+)/pile(\d+)$'),
+    'pile': re.compile(r'^pier(\d+)/pile(\d+)(?:/depth=(.+))?$'),
     'pier_top': re.compile(r'^pier(\d+)/top$'),
     'ground': re.compile(r'^ground/pier(\d+)/([A-Za-z0-9_]+)$'),
 }
 """The forms of ``at``: a point of girder NN at x m from its left support (``span07/x=16.0``),
 a point of a beam line at track position x (``girder@208.0``,
 ``rail_left@x``, ``slab@x``, ``base@x``), a car body (``car03``), a wheel
-(``car03/axle2/left``), a pile head (``pier07/pile05``), a pier top (``pier07/top``) and
+(``car03/axle2/left``), a pile head (``pier07/pile05``; a strain gauge also D m below it,
+``pier07/pile05/depth=3.0``), a pier top (``pier07/top``) and
 a ground point of a piled pier by its name in ``summary.json`` (``ground/pier07/line_01``)."""
 
 _TYPE_TEXT = ('What it measures: accelerometer (m/s^2), displacement (m; with relative_to the '
               'change of the distance between two points: a bearing LVDT), inclinometer '
-              '(rad), geophone (velocity, m/s), strain (girder or rail fibre strain) or '
+              '(rad), geophone (velocity, m/s), strain (girder or rail fibre strain; or a '
+              "pile's axial strain, tension positive) or "
               'wheel_force (an instrumented wheelset, N).')
 RATE_TOLERANCE = 1e-9
 """Relative tolerance of frame rate / sensor rate being an integer."""
@@ -89,8 +91,11 @@ class SensorConfig:
                       choices=SENSOR_TYPES)
     at: str = param('', '-', "Where: 'girder@x' (also rail_left, rail_right, slab, base; x "
                     "along the track, m), 'carNN' (car body), 'carNN/axleK/left|right' "
-                    "(wheel), 'pierNN/pileMM' (pile head), 'pierNN/top' (pier top) or "
-                    "'ground/pierNN/<point>' (a ground point by its summary.json name).")
+                    "(wheel), 'pierNN/pileMM' (pile head), 'pierNN/pileMM/depth=D' (strain: "
+                    "the pile's axial strain D m below its head, tension positive; "
+                    "without depth at the head), 'pierNN/top' (pier top: displacement, "
+                    "accelerometer) or 'ground/pierNN/<point>' (a ground point by its "
+                    'summary.json name).')
     relative_to: str = param('', '-', "displacement: a second point in the forms of 'at'; "
                              'the sensor reads at minus relative_to.')
     axes: tuple[str, ...] = param((), '-', 'Axes measured, a list of x, y, z in track axes '
@@ -149,7 +154,8 @@ class SensorConfig:
                               'x, y, z, each once')
         if self.type == 'strain' and joined not in ('', 'x'):
             raise SensorError(f'{self.name}: axes = {list(self.axes)!r}; a strain gauge '
-                              'measures the fibre strain along the beam only (axes [x] or [])')
+                              'measures the fibre strain along the beam (or the axial strain '
+                              'of a pile) only (axes [x] or [])')
         if len(self.fibre) != 2:
             raise SensorError(f'{self.name}: fibre = {list(self.fibre)!r}; expected [y, z] (m)')
         if self.relative_to and self.type != 'displacement':

@@ -30,7 +30,7 @@ from typing import Any, Sequence
 
 import numpy as np
 
-from ttb_sim.config.sensor_places import probe_requests
+from ttb_sim.config.sensor_places import gauge_requests, probe_requests
 from ttb_sim.config.sensor_records import SensorConfig, SensorError
 from ttb_sim.errors import ScenarioError
 from ttb_sim.sensors.acquisition import Acquisition, Samples
@@ -117,10 +117,14 @@ class SensorBank:
                                 f'sensors read {len(requests)} (a substructure alone has '
                                 'no beam lines: sensors at girder@x, rail_left@x ... need a '
                                 'train run)')
+        gauges = gauge_requests(sensors)
+        if len(gauges) != layout.pile_gauges:
+            raise ScenarioError(f'the model evaluates {layout.pile_gauges} pile strain gauges; '
+                                f'the sensors read {len(gauges)}')
         self.channels: list[SensorChannel] = []
         for i, config in enumerate(sensors):
             try:
-                at, relative = truth_columns(config, layout, requests)
+                at, relative = truth_columns(config, layout, requests, gauges)
                 acquisition = Acquisition(config, frame_rate, len(at))
             except (SensorError, ScenarioError) as exc:
                 raise ScenarioError(f'sensors[{i}]: {exc}') from None

@@ -17,7 +17,8 @@ Where a sensor's truth is: its location turned into columns of the frames' flat 
 
 The columns index :attr:`~ttb_sim.sim.frames.Frame.row`: the frame's own fields for
 sensors on piles, pier tops, cars, wheels and ground points, its ``probes`` for
-sensors on beam lines (:mod:`ttb_sim.config.sensor_places`).
+sensors on beam lines and its ``pile_strain`` for strain gauges on piles
+(:mod:`ttb_sim.config.sensor_places`).
 """
 
 from __future__ import annotations
@@ -26,8 +27,9 @@ from typing import Sequence
 
 import numpy as np
 
-from ttb_sim.config.sensor_places import (ALLOWED_PLACES, AXIS, GROUND_SLOTS, Location,
-                                          parse_location, ProbeRequest, request_of)
+from ttb_sim.config.sensor_places import (ALLOWED_PLACES, AXIS, gauge_of, GaugeRequest,
+                                          GROUND_SLOTS, Location, parse_location,
+                                          ProbeRequest, request_of)
 from ttb_sim.config.sensor_records import SensorConfig
 from ttb_sim.errors import ScenarioError
 from ttb_sim.sim import Layout, SOIL_VALUES
@@ -35,8 +37,9 @@ from ttb_sim.sim import Layout, SOIL_VALUES
 __all__ = ['truth_columns']
 
 
-def truth_columns(config: SensorConfig, layout: Layout,
-                  requests: Sequence[ProbeRequest]) -> tuple[np.ndarray, np.ndarray | None]:
+def truth_columns(config: SensorConfig, layout: Layout, requests: Sequence[ProbeRequest],
+                  gauges: Sequence[GaugeRequest] = ()
+                  ) -> tuple[np.ndarray, np.ndarray | None]:
     """
     Return the frame-row columns of a sensor's truth per axis, and of its ``relative_to``.
 
@@ -48,14 +51,14 @@ def truth_columns(config: SensorConfig, layout: Layout,
 
     """
     axes = [AXIS[a] for a in config.measured_axes]
-    at = _columns(config, config.at, layout, requests)[axes]
+    at = _columns(config, config.at, layout, requests, gauges)[axes]
     if not config.relative_to:
         return at, None
-    return at, _columns(config, config.relative_to, layout, requests)[axes]
+    return at, _columns(config, config.relative_to, layout, requests, gauges)[axes]
 
 
 def _columns(config: SensorConfig, text: str, layout: Layout,
-             requests: Sequence[ProbeRequest]) -> np.ndarray:
+             requests: Sequence[ProbeRequest], gauges: Sequence[GaugeRequest]) -> np.ndarray:
     """Return the three columns (x, y, z) of one location's quantity."""
     col = layout.columns()
     location = parse_location(text, config.name)
@@ -75,9 +78,13 @@ def _columns(config: SensorConfig, text: str, layout: Layout,
         if numbers[0] not in layout.piers:
             raise ScenarioError(f'{what}: pier {numbers[0]} reports no top; piers with a top: '
                                 f'{list(layout.piers)}')
-        return col['pier_tops'][layout.piers.index(numbers[0])]
+        return col[ALLOWED_PLACES[config.type]['pier_top']][layout.piers.index(numbers[0])]
     if location.kind == 'pile':
-        return col[ALLOWED_PLACES[config.type]['pile']][_pile(what, numbers, layout)]
+        index = _pile(what, numbers, layout)
+        gauge = gauge_of(config) if text == config.at else None
+        if gauge is not None:
+            return col['pile_strain'][list(gauges).index(gauge)]
+        return col[ALLOWED_PLACES[config.type]['pile']][index]
     return _ground(config, what, location, layout)
 
 

@@ -31,7 +31,8 @@ import numpy as np
 
 ROW_FIELDS = ('head_position', 'speed', 'midspan', 'bearings', 'body_acceleration',
               'body_angular_velocity', 'wheel_rail', 'observers', 'pile_displacement',
-              'pile_acceleration', 'pile_rotation_rate', 'soil_points', 'pier_tops', 'probes')
+              'pile_acceleration', 'pile_rotation_rate', 'soil_points', 'pier_tops', 'probes',
+              'pier_top_acceleration', 'pile_strain')
 """The fields of a :class:`Frame` in the order of :attr:`Frame.row` (after its leading zero)."""
 SOIL_VALUES = 12
 """Values per ground point: x, y, z, displacement, acceleration (the contract's nine), velocity."""
@@ -64,6 +65,9 @@ class Layout:
     ``user_01``, ``grid_RR_CC``): written to ``summary.json`` so analysis can tell them apart."""
     probes: int = 0
     """Number of beam-line probes the sensors read (:func:`ttb_sim.sensors.probe_requests`)."""
+    pile_gauges: int = 0
+    """Number of pile strain gauges the sensors read
+    (:func:`~ttb_sim.config.sensor_places.gauge_requests`)."""
 
     @property
     def n_piles(self) -> int:
@@ -80,7 +84,9 @@ class Layout:
                 'observers': (len(self.observers), 3), 'pile_displacement': piles,
                 'pile_acceleration': piles, 'pile_rotation_rate': piles,
                 'soil_points': (self.soil_points, SOIL_VALUES),
-                'pier_tops': (len(self.piers), 3), 'probes': (self.probes, 3)}
+                'pier_tops': (len(self.piers), 3), 'probes': (self.probes, 3),
+                'pier_top_acceleration': (len(self.piers), 3),
+                'pile_strain': (self.pile_gauges, 3)}
 
     @property
     def row_width(self) -> int:
@@ -150,6 +156,11 @@ class Frame:
         in :attr:`Layout.piers` order
     probes : (n_probes, 3) the beam-line quantities the sensors read, in
         :func:`~ttb_sim.sensors.probe_requests` order (SI units)
+    pier_top_acceleration : (n_piers, 3) acceleration of each pier top (m/s^2), the
+        integrated state's (not a difference of displacements), piers as ``pier_tops``
+    pile_strain : (n_gauges, 3) axial strain of the piles at the sensors' gauges (tension
+        positive), then two zeros, in
+        :func:`~ttb_sim.config.sensor_places.gauge_requests` order
 
     """
 
@@ -169,6 +180,8 @@ class Frame:
     soil_points: np.ndarray = field(default_factory=lambda: np.zeros((0, SOIL_VALUES)))
     pier_tops: np.ndarray = field(default_factory=lambda: np.zeros((0, 3)))
     probes: np.ndarray = field(default_factory=lambda: np.zeros((0, 3)))
+    pier_top_acceleration: np.ndarray = field(default_factory=lambda: np.zeros((0, 3)))
+    pile_strain: np.ndarray = field(default_factory=lambda: np.zeros((0, 3)))
 
     @cached_property
     def row(self) -> np.ndarray:
@@ -182,7 +195,8 @@ class Frame:
             ((0.0, self.head_position, self.speed), self.midspan, self.bearings,
              self.body_acceleration, self.body_angular_velocity, self.wheel_rail,
              self.observers, self.pile_displacement, self.pile_acceleration,
-             self.pile_rotation_rate, self.soil_points, self.pier_tops, self.probes), axis=None,
+             self.pile_rotation_rate, self.soil_points, self.pier_tops, self.probes,
+             self.pier_top_acceleration, self.pile_strain), axis=None,
             dtype=np.float64)
 
     @property

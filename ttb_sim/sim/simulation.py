@@ -366,21 +366,25 @@ class Simulation:
         st, cp = self.structure, self.coupling
         ue, ve, ae = self._extended(cp.structure_state())
         vehicle = cp.vehicle_outputs()
-        tops = self.foundations.tops() if self.foundations.active else None
-        pier_tops = ue[st.pier_top_dofs]
+        tops = self.foundations.top_states() if self.foundations.active else None
+        pier_tops, pier_acc = ue[st.pier_top_dofs], ae[st.pier_top_dofs]
         if tops is not None:   # partitioned piled piers: their tops are not structure DOFs
             moving = np.asarray(st.pier_supports)
-            pier_tops = np.where(st.pier_top_dofs == st.n_free, tops[0][moving, :3], pier_tops)
+            outside = st.pier_top_dofs == st.n_free
+            pier_tops = np.where(outside, tops[0][moving, :3], pier_tops)
+            pier_acc = np.where(outside, tops[2][moving, :3], pier_acc)
         piles = pile_outputs(st, self.foundations, ue, ve, ae)
         if piles:
             self.rigid.update(ue[st.midspan_dofs], piles['pile_displacement'])
             self.interface.update(pile_coordinates(st, self.foundations, ue))
         # The applied load enters only the reactions of rigid supports.
         load = cp.structure_load(head) if st.bearings is None else self._no_load
+        moved = None if tops is None else tops[:2]
         return Frame(step=step, time=step * self.dt, head_position=head, speed=self.speed,
                      midspan=ue[st.midspan_dofs],
-                     bearings=bearing_forces(st, ue, ve, ae, load, tops),
+                     bearings=bearing_forces(st, ue, ve, ae, load, moved),
                      body_acceleration=vehicle.body_acceleration,
                      body_angular_velocity=vehicle.body_angular_velocity,
                      wheel_rail=vehicle.wheel_rail, observers=self._observe(ue),
-                     pier_tops=pier_tops, probes=self.probes.values(self._state), **piles)
+                     pier_tops=pier_tops, probes=self.probes.values(self._state),
+                     pier_top_acceleration=pier_acc, **piles)

@@ -17,7 +17,8 @@ The observation operators of the pile-soil substructure: pile heads, ground surf
 
 Pile-head displacement is the area-weighted mean over the head nodes (the
 work-conjugate of a uniform head pressure), pile-head rotation a weighted
-least-squares rigid fit; the ground surface carries tributary areas for
+least-squares rigid fit, the piles' axial strain the difference of such means
+over each layer of their bricks; the ground surface carries tributary areas for
 uniform surface loads; soil points interpolate trilinearly in the containing
 cell.
 """
@@ -25,6 +26,7 @@ cell.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Sequence
 
 import numpy as np
 import scipy.sparse as sp
@@ -37,8 +39,9 @@ from ttb_sim.fe.quad import face_frames, FACE_N
 from ttb_sim.model.foundation.records import FoundationError, Substructure
 from ttb_sim.model.foundation.soil_mesh import CAP
 
-#: Local face of a cell on its top (+z).
+#: Local face of a cell on its top (+z), and on its bottom (-z).
 _TOP = 5
+_BOTTOM = 4
 
 
 @dataclass(frozen=True)
@@ -107,6 +110,73 @@ def head_operators(n_piles: int, cut: GridCells, cells: np.ndarray, nodes: np.nd
                              shape=shape)
 
     return op_matrix(rows_d, cols_d, vals_d), op_matrix(rows_r, cols_r, vals_r)
+
+
+def pile_strain_operator(n_piles: int, cut: GridCells, cells: np.ndarray, nodes: np.ndarray,
+                         pile: np.ndarray, n_dofs: int) -> tuple[sp.csr_matrix, np.ndarray]:
+    """
+    Return the piles' axial strain per element layer and the depths of the layers' planes.
+
+    Row ``pile * n_layers + layer`` (layers from the head down) is the cross-section mean
+    of eps_zz = du_z/dz over that layer of the pile's bricks: the area-weighted mean
+    vertical displacement of its top face less that of its bottom face, over the layer's
+    height (exact for trilinear bricks, whose du_z/dz does not vary along z; tension
+    positive). ``depths`` (n_layers + 1,) are the planes below the ground surface (the
+    pile head), 0 first (m). Piles of one group share their planes.
+    """
+    kz = cut.index[2]
+    layers = np.unique(kz[pile >= 0])[::-1]   # top down (grid z rises with k)
+    zs = cut.grid.zs
+    depths = 0.0 - np.concatenate([zs[layers[:1] + 1], zs[layers]]) if layers.size \
+        else np.zeros(1)
+    rows, cols, vals = [], [], []
+    for p in range(n_piles):
+        for n, k in enumerate(layers):
+            sel = np.flatnonzero((pile == p) & (kz == k))
+            height = zs[k + 1] - zs[k]
+            for face, sign in ((_TOP, 1.0), (_BOTTOM, -1.0)):
+                faces = cells[sel][:, HEX_FACES[face]]
+                _, weights = face_frames(nodes[faces])
+                w = _tributary(faces, weights, len(nodes))
+                at = np.flatnonzero(w)
+                rows.append(np.full(len(at), p * len(layers) + n))
+                cols.append(3 * at + 2)
+                vals.append(sign * w[at] / (w[at].sum() * height))
+    shape = (n_piles * len(layers), n_dofs)
+    if not rows:
+        return sp.csr_matrix(shape), depths
+    return sp.csr_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
+                         shape=shape), depths
+
+
+def gauge_rows(strain: np.ndarray | sp.csr_matrix, depths: np.ndarray,
+               gauges: Sequence[tuple[int, float]]) -> np.ndarray | sp.csr_matrix:
+    """
+    Return the rows of :func:`pile_strain_operator` (or their reduction) the gauges read.
+
+    ``gauges`` are (pile, 0-based; depth below the head, m): each reads the layer of
+    bricks whose planes enclose its depth, the lower one at a plane (the first layer at
+    the head, the last at the tip).
+
+    Raises
+    ------
+    FoundationError
+        For a pile not in the group or a depth below the pile tip.
+
+    """
+    n_layers = len(depths) - 1
+    n_piles = strain.shape[0] // max(n_layers, 1)
+    index = []
+    for pile, depth in gauges:
+        if not 0 <= pile < n_piles:
+            raise FoundationError(f'pile {pile + 1} does not exist; the group has {n_piles} '
+                                  f'(1 to {n_piles})')
+        if not 0.0 <= depth <= depths[-1] * (1 + 1e-9):
+            raise FoundationError(f'depth {depth:g} m is off the pile; allowed 0 to '
+                                  f'{depths[-1]:g} m below the head (piles.length)')
+        layer = int(np.searchsorted(depths, depth, side='right')) - 1
+        index.append(pile * n_layers + min(max(layer, 0), n_layers - 1))
+    return strain[np.asarray(index, dtype=np.intp)]
 
 
 def surface_weights(cut: GridCells, kind: np.ndarray, cells: np.ndarray,

@@ -61,7 +61,8 @@ from ttb_sim.model.constants import GRAVITY
 from ttb_sim.model.foundation.consistency import check_substructure
 from ttb_sim.model.foundation.desai import DesaiLaw, initial_moduli
 from ttb_sim.model.foundation.observation import (cap_top_weights, head_operators,
-                                                  soil_points, SoilPoints, surface_weights)
+                                                  pile_strain_operator, soil_points,
+                                                  SoilPoints, surface_weights)
 from ttb_sim.model.foundation.records import PileLoad, Substructure
 from ttb_sim.model.foundation.soil_mesh import (CAP, CellTags, check_aspect, InterfaceSplit,
                                                 PILE, SOIL, soil_grid, split_interface,
@@ -112,6 +113,11 @@ class PileSoilModel:
     cell_coordinates : array, shape (m, 8, 3)
         Corner coordinates of each cell (m), those the element matrices were
         integrated on (``mesh.nodes[mesh.cells]`` but across a periodic seam).
+    pile_strain : csr, shape (n_piles n_layers, n_dofs)
+        Axial strain (tension positive) of each pile's element layers, head down
+        (:func:`~.observation.pile_strain_operator`; apply to u).
+    pile_layer_depths : array, shape (n_layers + 1,)
+        Depths of the layers' planes below the pile heads (m), 0 first.
 
     """
 
@@ -136,6 +142,8 @@ class PileSoilModel:
     soil_points: SoilPoints
     summary: dict = field(default_factory=dict)
     cell_coordinates: np.ndarray = field(default_factory=lambda: np.zeros((0, 8, 3)))
+    pile_strain: sp.csr_matrix = field(default_factory=lambda: sp.csr_matrix((0, 0)))
+    pile_layer_depths: np.ndarray = field(default_factory=lambda: np.zeros(1))
 
     @property
     def n_dofs(self) -> int:
@@ -246,13 +254,15 @@ def build(spec: Substructure, load: Optional[PileLoad] = None) -> PileSoilModel:
     iface, law = _interface(spec, split, n_dofs)
     head_d, head_r = head_operators(spec.piles.count if spec.piles else 0, cut, cells,
                                     mesh.nodes, tags.pile, n_dofs)
+    strain, layer_depths = pile_strain_operator(spec.piles.count if spec.piles else 0, cut,
+                                                cells, mesh.nodes, tags.pile, n_dofs)
     surface_w = surface_weights(cut, tags.kind, cells, mesh.n_nodes)
     points = soil_points(spec, cut, cells, n_dofs)
     summary = _summary(spec, mesh, tags.kind, aspect, iface, n_dofs, free)
     _report(summary, load)
     return PileSoilModel(spec, grid, mesh, tags.kind, free, mass, k_soil, c_soil, k_str, c_str,
                          k_b, c_b, iface, law, structure_dofs, head_d, head_r, surface_w,
-                         points, summary, cut.coordinates)
+                         points, summary, cut.coordinates, strain, layer_depths)
 
 
 def _outer_faces(cut: GridCells, tags: CellTags,

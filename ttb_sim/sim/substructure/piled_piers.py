@@ -243,12 +243,15 @@ class PiledFoundations:
 
     def tops(self) -> tuple[np.ndarray, np.ndarray]:
         """Return the pier-top (u, v), shape (n_supports, 6), at the bridge's current time."""
-        u = np.zeros((self.n_supports, len(TOP)))
-        v = np.zeros_like(u)
-        for pier, state in zip(self.piers, self.current()):
-            u[pier.support] = state.u[TOP]
-            v[pier.support] = state.v[TOP]
+        u, v, _ = self.top_states()
         return u, v
+
+    def top_states(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Return the pier-top (u, v, a), shape (n_supports, 6), at the bridge's current time."""
+        out = np.zeros((3, self.n_supports, len(TOP)))
+        for pier, state in zip(self.piers, self.current()):
+            out[:, pier.support] = state.u[TOP], state.v[TOP], state.a[TOP]
+        return out[0], out[1], out[2]
 
 
 def pile_coordinates(structure: Structure, foundations: PiledFoundations,

@@ -47,10 +47,14 @@ import math
 from typing import Any, Iterator, Literal
 
 import numpy as np
+import scipy.sparse as sp
 
 from ttb_sim.config import Scenario
+from ttb_sim.config.sensor_places import gauge_requests, GaugeRequest
 from ttb_sim.errors import DivergenceError, ScenarioError
 from ttb_sim.fe.factorization import resolve
+from ttb_sim.model.foundation.observation import gauge_rows
+from ttb_sim.model.foundation.records import FoundationError
 from ttb_sim.model.foundation.soil_mesh import CAP, PILE, planned_nodes, SOIL
 from ttb_sim.model.foundation.substructure import build, PileSoilModel
 from ttb_sim.sim.cost import CostEstimate, STEP_BUDGET
@@ -158,11 +162,15 @@ class SubstructureRun:
         self.model: PileSoilModel = build(scenario.substructure('pier01'), self.load)
         self.force = self.model.load_vector(self.load)
         model = self.model
+        gauges = gauge_requests(scenario.all_sensors)
+        self.gauges = self._gauge_rows(gauges)
+        """The pile strain gauges' rows over the model's DOFs (apply to u)."""
         self.layout = Layout(n_spans=0, n_supports=0, n_bodies=0,
                              piles=((1, model.n_piles),),
                              soil_points=len(model.soil_points.names), train=False,
                              soil_point_names=tuple(f'pier01/{name}'
-                                                    for name in model.soil_points.names))
+                                                    for name in model.soil_points.names),
+                             pile_gauges=len(gauges))
         self.scheme: Literal['mixed', 'implicit'] = (
             'implicit' if self.variant.pile_soil_scheme == 'implicit' else 'mixed')
         self.stable_step = math.inf
@@ -270,6 +278,19 @@ class SubstructureRun:
                             counts['cut_steps'], self.n_steps, counts['cuts'],
                             counts['line_searches'])
 
+    def _gauge_rows(self, gauges: tuple[GaugeRequest, ...]) -> sp.csr_matrix:
+        """Return the strain rows of the gauges (the group is pier01)."""
+        for g in gauges:
+            if g.pier != 1:
+                raise ScenarioError(f'a strain gauge at pier{g.pier:02d}/pile{g.pile:02d}: a '
+                                    'substructure alone is pier01')
+        model = self.model
+        try:
+            return gauge_rows(model.pile_strain, model.pile_layer_depths,
+                              [(g.pile - 1, g.depth) for g in gauges])
+        except FoundationError as exc:
+            raise ScenarioError(f'pile strain gauge: {exc}') from None
+
     def _frame(self, step: int, state: State) -> Frame:
         limit = self.scenario.solver.divergence_limit
         largest = float(np.max(np.abs(state.u), initial=0.0))
@@ -287,7 +308,15 @@ class SubstructureRun:
                      wheel_rail=np.zeros((0, 1, 2, 3)), observers=empty,
                      pile_displacement=obs.pile_displacement,
                      pile_acceleration=obs.pile_acceleration,
-                     pile_rotation_rate=obs.pile_rotation_rate, soil_points=points)
+                     pile_rotation_rate=obs.pile_rotation_rate, soil_points=points,
+                     pile_strain=_padded(self.gauges @ state.u))
+
+
+def _padded(values: np.ndarray) -> np.ndarray:
+    """Return values (n,) as rows (n, 3): the value, then two zeros (as the probes)."""
+    out = np.zeros((len(values), 3))
+    out[:, 0] = values
+    return out
 
 
 def substructure_dof_counts(run: SubstructureRun) -> dict[str, int]:
