@@ -160,3 +160,17 @@ def test_pier_top_accelerometers_in_the_pier_layout():
     s = load_scenario('live_coupled', ['sensor_layouts=[pier:7]', 'output.rate_hz=1000'])
     top = next(c for c in s.all_sensors if c.name == 'pier07_top_acc')
     assert top.at == 'pier07/top' and top.type == 'accelerometer' and top.measured_axes == 'xyz'
+
+
+def test_pile_strain_gauges_on_a_reduced_piled_pier(tmp_path):
+    """live_coupled: the gauges read interior pile DOFs recovered through the reduction basis."""
+    out = tmp_path / 'bag'
+    gauges = ('[{name: head, type: strain, at: pier07/pile08, rate_hz: 500}, '
+              '{name: deep, type: strain, at: "pier07/pile08/depth=5", rate_hz: 500}]')
+    assert main(['run', 'live_coupled', '--out', str(out), '--duration', '0.3', '--set',
+                 'output.rate_hz=1000', '--set', f'sensors={gauges}']) == 0
+    bag = read_bag(out)
+    head = bag['/ttb_sim/sensors/head'].fields['vector'][:, 0]
+    deep = bag['/ttb_sim/sensors/deep'].fields['vector'][:, 0]
+    assert np.all(np.isfinite(head)) and 1e-9 < np.abs(head).max() < 1e-5
+    assert np.sqrt(np.mean(deep**2)) < np.sqrt(np.mean(head**2))

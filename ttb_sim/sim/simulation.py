@@ -28,7 +28,7 @@ from typing import Any, Iterator
 import numpy as np
 
 from ttb_sim.config import Scenario
-from ttb_sim.config.sensor_places import probe_requests
+from ttb_sim.config.sensor_places import gauge_requests, probe_requests
 from ttb_sim.errors import DivergenceError, ModelError, ScenarioError
 from ttb_sim.fe.compiled import parallel_threads, pending
 from ttb_sim.model.bearings import bearing_forces
@@ -41,7 +41,8 @@ from ttb_sim.sim.coupling import FusedCoupling
 from ttb_sim.sim.frames import Frame, Layout
 from ttb_sim.sim.integrators.newmark import Newmark
 from ttb_sim.sim.substructure.piled_piers import (InterfaceCheck, pile_coordinates, pile_outputs,
-                                                  PiledFoundations, RigidDisplacement)
+                                                  PiledFoundations, PileGauges,
+                                                  RigidDisplacement)
 from ttb_sim.sim.variants import blas_threads, resolve_threads, solver_variant
 
 log = logging.getLogger(__name__)
@@ -153,6 +154,9 @@ class Simulation:
         b, pr = scenario.bridge, scenario.piers
         self.interface = InterfaceCheck(st, GRAVITY * (b.mass_per_length * b.span_length
                                                        + pr.mass_per_length * pr.height))
+        self.gauges = PileGauges.of(st, [(g.pier, g.pile, g.depth)
+                                         for g in gauge_requests(scenario.all_sensors)])
+        """The pile strain gauges the sensors read (through the reduction basis)."""
         self.layout = Layout(n_spans=scenario.bridge.n_spans, n_supports=st.n_supports,
                              n_bodies=self.coupling.n_bodies, n_axles=self.coupling.n_axles,
                              observers=names,
@@ -163,7 +167,7 @@ class Simulation:
                              soil_point_names=tuple(f'pier{p.support + 1:02d}/{name}'
                                                     for p in st.piled
                                                     for name in p.operator.soil_point_names),
-                             probes=len(self.probes.states))
+                             probes=len(self.probes.states), pile_gauges=self.gauges.count)
         self._no_load = np.zeros(0)
         self._state = np.zeros((3, 0))
         self.compiled_loop = False
@@ -373,7 +377,7 @@ class Simulation:
             outside = st.pier_top_dofs == st.n_free
             pier_tops = np.where(outside, tops[0][moving, :3], pier_tops)
             pier_acc = np.where(outside, tops[2][moving, :3], pier_acc)
-        piles = pile_outputs(st, self.foundations, ue, ve, ae)
+        piles = pile_outputs(st, self.foundations, ue, ve, ae, self.gauges)
         if piles:
             self.rigid.update(ue[st.midspan_dofs], piles['pile_displacement'])
             self.interface.update(pile_coordinates(st, self.foundations, ue))

@@ -114,6 +114,19 @@ def test_static_flexibility_and_pile_heads_equal_the_unreduced_model(full, large
     assert np.abs(heads_red - heads_full).max() < 1e-9 * np.abs(heads_full).max()
 
 
+def test_pile_strain_recovered_through_the_basis_equals_the_unreduced_model(full, large):
+    """Interior pile DOFs through Psi and V: the layers' axial strain to 1e-9, compressed."""
+    rhs = np.zeros(full.mass.shape[0])
+    rhs[2] = -1e6                      # 1 MN down on the pier top
+    u_full = spla.splu(sp.csc_matrix(full.stiffness)).solve(rhs)
+    u_red = np.linalg.solve(large.stiffness, rhs[:large.size])
+    strain_full, strain_red = full.pile_strain @ u_full, large.pile_strain @ u_red
+    assert large.pile_strain.shape == (2 * (len(large.pile_layer_depths) - 1), large.size)
+    assert large.pile_layer_depths[0] == 0.0 and large.pile_layer_depths[-1] == 4.0
+    assert np.abs(strain_red - strain_full).max() < 1e-9 * np.abs(strain_full).max()
+    assert np.all(strain_red < 0.0)
+
+
 def test_pier_column_stands_on_the_cap_top(full):
     """Pier-top flexibility = cap-top flexibility carried up the lever + cantilever (1e-9)."""
     n = full.mass.shape[0]

@@ -108,6 +108,11 @@ class FoundationOperator:
         Rigid rotation of each pile head from q (apply to q' for the rate).
     interface : InterfaceRows or None
         Pile-soil interface tractions and strength from q (None: no interface).
+    pile_strain : array (n_piles n_layers, n) or None
+        Axial strain (tension positive) of each pile's element layers, head down, from q
+        (:func:`~.observation.pile_strain_operator` through the reduction; None: no piles).
+    pile_layer_depths : array (n_layers + 1,) or None
+        Depths of the layers' planes below the pile heads (m), 0 first.
 
     """
 
@@ -123,6 +128,8 @@ class FoundationOperator:
     summary: dict[str, Any] = field(default_factory=dict)
     pile_rotations: np.ndarray | None = None
     interface: Optional[InterfaceRows] = None
+    pile_strain: np.ndarray | None = None
+    pile_layer_depths: np.ndarray | None = None
 
     @property
     def size(self) -> int:

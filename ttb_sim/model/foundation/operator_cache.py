@@ -42,7 +42,7 @@ from ttb_sim.model.foundation.records import FoundationError, ReductionParameter
 
 LOG = logging.getLogger(__name__)
 
-FORMAT = 2
+FORMAT = 3
 """Version of the reduction and of its cache files; part of the cache key."""
 
 
@@ -69,6 +69,7 @@ def cache_key(spec: Substructure, pier_height: float, pier_elements: int,
 _ARRAYS = ('mass', 'damping', 'stiffness', 'pile_heads', 'pile_positions', 'soil_points',
            'soil_point_positions', 'pile_rotations')
 _INTERFACE = ('normal', 'shear', 'sigma_n0', 'cohesion', 'tan_delta')
+_OPTIONAL = ('pile_strain', 'pile_layer_depths')
 
 
 def save_operator(path: Path, op: FoundationOperator) -> None:
@@ -77,6 +78,7 @@ def save_operator(path: Path, op: FoundationOperator) -> None:
     arrays['soil_point_names'] = np.array(op.soil_point_names, dtype=str)
     arrays['depth'] = np.array(op.depth)
     arrays['summary'] = np.array(json.dumps(op.summary))
+    arrays.update({n: getattr(op, n) for n in _OPTIONAL if getattr(op, n) is not None})
     if op.interface is not None:
         arrays.update({f'interface_{n}': getattr(op.interface, n) for n in _INTERFACE})
     tmp = path.with_name(f'.{path.name}.{os.getpid()}.tmp')
@@ -106,10 +108,13 @@ def load_operator(path: Path) -> Optional[FoundationOperator]:
         op = FoundationOperator(**{name: got[name] for name in _ARRAYS},
                                 soil_point_names=tuple(str(s) for s in got['soil_point_names']),
                                 depth=float(got['depth']),
-                                summary=json.loads(str(got['summary'])), interface=iface)
+                                summary=json.loads(str(got['summary'])), interface=iface,
+                                pile_strain=got.get('pile_strain'),
+                                pile_layer_depths=got.get('pile_layer_depths'))
         square = all(getattr(op, a).shape == (n, n) for a in ('mass', 'damping', 'stiffness'))
         if (not square or op.pile_heads.shape != (3 * op.n_piles, n)
-                or op.soil_points.shape != (3 * len(op.soil_point_names), n)):
+                or op.soil_points.shape != (3 * len(op.soil_point_names), n)
+                or (op.pile_strain is not None and op.pile_strain.shape[1] != n)):
             raise FoundationError('arrays of inconsistent shapes')
         return op
     except Exception as err:  # noqa: B902 - any unreadable cache file means: rebuild

@@ -47,10 +47,12 @@ The reduced-order pier-cap-pile-soil substructure of one piled pier.
 
 q = [column nodes from the top down to the one above the master (6 each),
 master (6), generalised coordinates of V]. Outputs are the model's
-observation operators through the basis: pile-head mean displacements and
-soil points, and (:class:`~.operator.InterfaceRows`) the interface tractions
-at the initial tangent with their Mohr-Coulomb strength, so that
-:func:`interface_mobilisation` can show a run stayed linear.
+observation operators through the basis: pile-head mean displacements, soil
+points, the piles' axial strain per element layer (of interior pile DOFs, which
+q does not hold: recovered through the rows of Psi and V), and
+(:class:`~.operator.InterfaceRows`) the interface tractions at the initial
+tangent with their Mohr-Coulomb strength, so that :func:`interface_mobilisation`
+can show a run stayed linear.
 
 The operator of a given set of inputs is cached on disk (``$TTB_SIM_CACHE``
 or ``~/.cache/ttb_sim``) under a hash of every input (:mod:`.operator_cache`);
@@ -160,6 +162,7 @@ class SparseOperator:
     stiffness: sp.csr_matrix
     pile_heads: sp.csr_matrix
     soil_points: sp.csr_matrix
+    pile_strain: Optional[sp.csr_matrix] = None
 
 
 def pile_soil_operator(spec: Substructure, pier_height: float, pier_elements: int,
@@ -248,6 +251,7 @@ def _build(spec: Substructure, pier_height: float, pier_elements: int,
     heads = _rows(model.head_displacement, tied, phi, lead)
     rotations = _rows(model.head_rotation, tied, phi, lead)
     points = _rows(model.soil_points.operator, tied, phi, lead)
+    strain = _rows(model.pile_strain, tied, phi, lead)   # interior pile DOFs via the basis
     assert spec.piles is not None
     centre = np.array(spec.piles.centre, dtype=float)
     positions = np.array(spec.piles.centres(), dtype=float) - centre
@@ -266,7 +270,8 @@ def _build(spec: Substructure, pier_height: float, pier_elements: int,
                               soil_point_positions=soil_positions,
                               depth=float(pier_height + spec.cap.thickness), summary=summary,
                               interface=_interface_rows(tied, phi, lead),
-                              pile_rotations=rotations)
+                              pile_rotations=rotations, pile_strain=strain,
+                              pile_layer_depths=model.pile_layer_depths.copy())
 
 
 def _galerkin(a: sp.csr_matrix, phi: np.ndarray) -> np.ndarray:
@@ -379,7 +384,7 @@ def unreduced_operator(spec: Substructure, pier_height: float, pier_elements: in
         return sp.hstack([sp.csr_matrix((sub.shape[0], lead)), sub]).tocsr()
 
     return SparseOperator(mass, damping, stiffness, rows(model.head_displacement),
-                          rows(model.soil_points.operator))
+                          rows(model.soil_points.operator), rows(model.pile_strain))
 
 
 def dynamic_flexibility(mass: Any, damping: Any, stiffness: Any, frequencies: np.ndarray,

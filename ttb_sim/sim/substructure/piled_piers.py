@@ -60,12 +60,15 @@ is the unconditionally stable reference.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Callable
+from typing import Callable, Sequence
 
 import numpy as np
 import scipy.linalg as sla
 
+from ttb_sim.errors import ScenarioError
+from ttb_sim.model.foundation.observation import gauge_rows
 from ttb_sim.model.foundation.operator import TOP
+from ttb_sim.model.foundation.records import FoundationError
 from ttb_sim.model.structure import PiledPier, Structure
 
 
@@ -266,21 +269,67 @@ def pile_coordinates(structure: Structure, foundations: PiledFoundations,
     return out
 
 
+@dataclass(frozen=True)
+class PileGauges:
+    """The pile strain gauges of a structure: per piled pier, its gauges' rows over q."""
+
+    count: int
+    """Number of gauges (all piers)."""
+    rows: dict[int, tuple[np.ndarray, np.ndarray]]
+    """Per index into ``structure.piled``: (the gauges' places in frame order, rows (g, n))."""
+
+    @classmethod
+    def of(cls, structure: Structure, requests: Sequence[tuple[int, int, float]]
+           ) -> PileGauges:
+        """
+        Return the gauges ``requests`` (pier 1-based, pile 1-based, depth m) read.
+
+        Raises
+        ------
+        ScenarioError
+            For a pier that is not piled, a pile not in its group or a depth off the pile.
+
+        """
+        supports = [p.support + 1 for p in structure.piled]
+        wanted: dict[int, list[tuple[int, int, float]]] = {}
+        for place, (pier, pile, depth) in enumerate(requests):
+            if pier not in supports:
+                raise ScenarioError(f'pile strain gauge at pier{pier:02d}/pile{pile:02d}: pier '
+                                    f'{pier} is not piled; piled piers: {supports}')
+            wanted.setdefault(supports.index(pier), []).append((place, pile - 1, depth))
+        rows = {}
+        for k, items in wanted.items():
+            op = structure.piled[k].operator
+            if op.pile_strain is None or op.pile_layer_depths is None:
+                raise ScenarioError(f'pier{supports[k]:02d}: its foundation has no pile '
+                                    'strain rows (a pier column on springs)')
+            try:
+                matrix = gauge_rows(op.pile_strain, op.pile_layer_depths,
+                                    [(pile, depth) for _, pile, depth in items])
+            except FoundationError as exc:
+                raise ScenarioError(f'pile strain gauge at pier{supports[k]:02d}: {exc}'
+                                    ) from None
+            rows[k] = (np.array([place for place, _, _ in items]), np.asarray(matrix))
+        return cls(len(requests), rows)
+
+
 def pile_outputs(structure: Structure, foundations: PiledFoundations, ue: np.ndarray,
-                 ve: np.ndarray, ae: np.ndarray) -> dict[str, np.ndarray]:
+                 ve: np.ndarray, ae: np.ndarray,
+                 gauges: PileGauges | None = None) -> dict[str, np.ndarray]:
     """
     Return the pile and soil fields of a :class:`~ttb_sim.sim.frames.Frame` (none unpiled).
 
     Monolithic piers read their coordinates from the structure state (extended
     free ue, ve, ae); partitioned ones from ``foundations`` at the current time.
     Soil points are placed in track axes: x from the pier's support, z from the
-    ground surface ``depth`` below the bearings.
+    ground surface ``depth`` below the bearings. ``gauges`` adds ``pile_strain``.
     """
     if not structure.piled:
         return {}
     states = iter(foundations.current())
     disp, acc, rot, soil = [], [], [], []
-    for pier in structure.piled:
+    strain = np.zeros((gauges.count if gauges is not None else 0, 3))
+    for k, pier in enumerate(structure.piled):
         op = pier.operator
         if pier.block is not None:
             q, qv, qa = ue[pier.block], ve[pier.block], ae[pier.block]
@@ -297,8 +346,12 @@ def pile_outputs(structure: Structure, foundations: PiledFoundations, ue: np.nda
         points = (op.soil_points @ states_q).reshape(-1, 3, 3)   # (point, axis, u|a|v)
         soil.append(np.hstack([op.soil_point_positions + origin,
                                *points.transpose(2, 0, 1)]))
+        if gauges is not None and k in gauges.rows:
+            places, rows = gauges.rows[k]
+            strain[places, 0] = rows @ q
     return {'pile_displacement': np.vstack(disp), 'pile_acceleration': np.vstack(acc),
-            'pile_rotation_rate': np.vstack(rot), 'soil_points': np.vstack(soil)}
+            'pile_rotation_rate': np.vstack(rot), 'soil_points': np.vstack(soil),
+            'pile_strain': strain}
 
 
 class RigidDisplacement:
