@@ -232,6 +232,11 @@ def _add_bag_verbs(sub: Any) -> None:
                      'Nyquist frequency)')
     idn.add_argument('--points', type=int, default=48, help='PSD grid points (default 48)')
     idn.add_argument('--segment', type=float, help='Welch segment, s (default min(2, record/4))')
+    where = idn.add_mutually_exclusive_group()
+    where.add_argument('--workers', type=int, help='local worker processes for the design runs '
+                       '(default: the number of cores, at most the number of runs)')
+    where.add_argument('--scheduler', metavar='ADDRESS', help='Dask scheduler, e.g. '
+                       "tcp://host:8786 (pip install 'ttb_sim[dask]')")
 
     sc = sub.add_parser('scenarios', help='list the built-in scenarios')
     sc.add_argument('--keys', action='store_true',
@@ -346,7 +351,8 @@ def _main(argv: Sequence[str] | None) -> int:
                                     design=args.design, steps=args.steps, walkers=args.walkers,
                                     seed=args.seed, discrepancy=args.discrepancy,
                                     fmin=args.fmin, fmax=args.fmax, points=args.points,
-                                    segment=args.segment, response=args.response)
+                                    segment=args.segment, response=args.response,
+                                    workers=args.workers, scheduler=args.scheduler)
         if args.command == 'bench':
             from ttb_sim.commands.bench import bench_command
             return bench_command(args.scenarios, variants=args.variants,

@@ -13,15 +13,26 @@
 # limitations under the License.
 
 
-"""``ttb-sim identify``: the posterior from a bag alone, its files, and refusals in one line."""
+"""``ttb-sim identify``: the posterior from a bag alone, its files, refusals, its workers."""
 
 import json
+import os
 from pathlib import Path
+import signal
+import subprocess
+import sys
 
+import numpy as np
 import pytest
 from ttb_sim.cli import main
+from ttb_sim.commands.identify import PoolRunner
+from ttb_sim.twin import FeatureSpec, ForwardModel
 
 pytest.importorskip('emcee', reason="pip install 'ttb_sim[twin]'")
+
+ROOT = Path(__file__).resolve().parents[2]
+HANG_BOUND = 300.0
+"""Seconds after which identify is taken as hung (a bound, not a speed check)."""
 
 SET = ['--set', 'sensor_layouts=[span:1]', '--set', 'output.rate_hz=1000', '--set',
        'solver.dt=0.0005']
@@ -59,6 +70,7 @@ def test_a_hidden_loss_from_the_bag_alone(observed, tmp_path, capsys):
     ([*ARGS, '--sensors', 'nope'], "no sensor 'nope'"),
     ([*ARGS, '--steps', '5'], '--steps 5'),
     ([], 'at least one --param'),
+    ([*ARGS, '--workers', '0'], '--workers 0 must be from 1 to'),
 ])
 def test_bad_input_exits_2_in_one_line_and_writes_nothing(observed, tmp_path, capsys, args,
                                                           words):
@@ -72,3 +84,51 @@ def test_bad_input_exits_2_in_one_line_and_writes_nothing(observed, tmp_path, ca
 def test_a_bag_without_its_scenario_needs_one(tmp_path, capsys):
     assert main(['identify', str(tmp_path / 'missing'), *ARGS]) == 2
     assert 'missing' in capsys.readouterr().err
+
+
+def test_the_design_is_the_same_bits_on_one_or_two_workers():
+    model = ForwardModel('moving_force_beam', ['damage.girders[0].loss'],
+                         overrides=[*SET[1::2], 'solver.duration=0.3',
+                                    LOSS.replace('0.3}', '0.0}')],
+                         sensors=['span01_acc_mid'], noise=False,
+                         features=FeatureSpec(psd_fmin_hz=4.0, psd_fmax_hz=90.0,
+                                              psd_points=12, psd_segment_s=0.25))
+    thetas = [[0.1], [2.0], [0.3]]   # the second refused: recorded, the others go on
+    here = model.evaluate_many(thetas)
+    assert [r['status'] for r in here] == ['ok', 'failed', 'ok']
+    assert 'damage.girders[0].loss = 2.0' in here[1]['error']
+    for workers in (1, 2):
+        seen = []
+        with PoolRunner(len(thetas), workers) as runner:
+            there = model.evaluate_many(thetas, runner, lambda run, r: seen.append(run.index))
+        assert sorted(seen) == [0, 1, 2]
+        assert [r['status'] for r in there] == ['ok', 'failed', 'ok']
+        for a, b in zip(here, there):
+            assert a['status'] != 'ok' or np.array_equal(a['vector'], b['vector'])
+
+
+@pytest.mark.parametrize('sig, code, at', [
+    (signal.SIGTERM, 143, 'design of'),         # setting up (the bag read, the model built)
+    (signal.SIGINT, 130, 'design run 1/'),      # the design running on two workers
+])
+def test_a_signal_stops_the_workers_and_writes_nothing(observed, tmp_path, sig, code, at):
+    out = tmp_path / 'id'
+    env = {**os.environ, 'PYTHONPATH': os.pathsep.join(
+        [str(ROOT), os.environ.get('PYTHONPATH', '')])}
+    proc = subprocess.Popen([sys.executable, '-m', 'ttb_sim.cli', 'identify', str(observed),
+                             *ARGS, '--design', '12', '--workers', '2', '--out', str(out)],
+                            stderr=subprocess.PIPE, stdout=subprocess.PIPE, text=True,
+                            env=env)
+    assert proc.stderr is not None
+    seen = []
+    for line in proc.stderr:
+        seen.append(line)
+        if at in line:
+            break
+    proc.send_signal(sig)
+    err = ''.join(seen) + proc.communicate(timeout=HANG_BOUND)[1]
+    assert proc.returncode == code, err
+    assert err.strip().splitlines()[-1] == \
+        f'ttb-sim: stopped by {signal.Signals(sig).name}; nothing written', err
+    assert 'Traceback' not in err
+    assert list(tmp_path.iterdir()) == []   # no folder, no staging folder left behind

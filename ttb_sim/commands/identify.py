@@ -19,7 +19,7 @@ The ``identify`` verb: Bayesian updating of scenario keys from a recorded passag
 ``ttb-sim identify BAG --param KEY=uniform:A,B [--param ...] --out DIR
 [--scenario SCENARIO] [--set KEY=VALUE ...] [--sensors a,b] [--design N] [--steps N]
 [--walkers N] [--seed N] [--discrepancy X] [--fmin HZ] [--fmax HZ] [--points N]
-[--segment S]``
+[--segment S] [--workers N | --scheduler ADDRESS]``
 
 The model to update is ``--scenario`` (with ``--set``), or by default the scenario the
 bag was recorded from (stored in its metadata by ``ttb-sim run``; a bag recorded
@@ -29,6 +29,12 @@ is :mod:`ttb_sim.twin.identify`.  ``DIR`` receives ``posterior.json`` (per key
 ``median``, ``q05``, ``q95``, ``identified`` and the diagnostics), ``chains.npz``,
 ``corner.png``, ``trace.png``, ``fit.png`` and ``index.html``; it is written whole
 at the end (nothing half-written on an error or a signal).
+
+The design runs go to local worker processes or a Dask cluster
+(:mod:`ttb_sim.commands.pool`, as for ``dataset`` and ``sweep``): the command hands
+:func:`~ttb_sim.twin.identify.identify` a runner over the pool, so the twin layer
+needs no processes of its own.  The result is the same bit for bit whatever the
+number of workers; a Ctrl-C stops the workers and writes nothing (exit 128 + signal).
 """
 
 from __future__ import annotations
@@ -36,20 +42,25 @@ from __future__ import annotations
 from pathlib import Path
 import re
 import sys
+import threading
 import time
 from typing import Any, Sequence
 
 import numpy as np
 
+from ttb_sim.commands.pool import check_workers, make_pool, run_cases
+from ttb_sim.commands.signals import raise_stopped, signal_name, SignalHandlers, Stopped
 from ttb_sim.errors import ScenarioError
 from ttb_sim.inputs import shown
 
-__all__ = ['identify_command', 'parse_param']
+__all__ = ['identify_command', 'parse_param', 'PoolRunner']
 
 EXIT_OK = 0
 PARAM = re.compile(r'^(?P<key>[^=]+)=(?P<kind>[a-z]+):(?P<args>.*)$')
 FAMILIES = ('uniform', 'normal', 'lognormal')
 MAX_PARAMS = 8
+MODEL_SCENARIO = 'model_scenario.yaml'
+"""The bag's own scenario, as the model loads it (in the output folder)."""
 
 
 def parse_param(text: str) -> Any:
@@ -80,7 +91,7 @@ def _model_scenario(bag: Path, scenario: str | None, stage: Path) -> str:
         raise ScenarioError(f'bag {str(bag)!r} does not carry the scenario it was recorded from '
                             '(recorded by ros2 bag record, or by another tool): give the model '
                             'with --scenario NAME_OR_YAML')
-    path = stage / 'model_scenario.yaml'
+    path = stage.resolve() / MODEL_SCENARIO   # the same path for every worker
     path.write_text(yaml.safe_dump(data, sort_keys=False), encoding='utf-8')
     return str(path)
 
@@ -90,13 +101,15 @@ def identify_command(bag: str | Path, params: Sequence[str], *, out: str | Path 
                      sensors: str | None = None, design: int = 0, steps: int = 3000,
                      walkers: int = 0, seed: int = 0, discrepancy: float = 0.02,
                      fmin: float | None = None, fmax: float | None = None, points: int = 48,
-                     segment: float | None = None, response: str = 'passage') -> int:
+                     segment: float | None = None, response: str = 'passage',
+                     workers: int | None = None, scheduler: str | None = None) -> int:
     """Run ``ttb-sim identify``; return the exit code."""
     from ttb_sim.io.bag_checks import check_bag_path
     from ttb_sim.report.output import staged_output
     from ttb_sim.twin.identify import IdentifySettings
     start = time.perf_counter()
     path = Path(bag)
+    check_workers(workers, scheduler)
     if not params:
         raise ScenarioError('give at least one --param KEY=FAMILY:A,B to identify')
     if len(params) > MAX_PARAMS:
@@ -111,28 +124,93 @@ def identify_command(bag: str | Path, params: Sequence[str], *, out: str | Path 
     target = Path(out) if out is not None else \
         (path if path.is_dir() else path.parent) / 'identify'
     _check_out(target)
-    with staged_output(target) as stage:
-        model, observed, record = _set_up(path, stage, scenario, overrides, keys, sensors,
-                                          fmin, fmax, points, segment, priors)
-        print(f'ttb-sim: identify: {len(keys)} parameter(s) from {len(model.sensors)} '
-              f'sensor(s), {record:.3g} s recorded; design of '
-              f'{settings.design or 8 * len(keys) + 8} runs', file=sys.stderr)
-        from ttb_sim.twin.identify import identify
-        result = identify(model, priors, observed, record, settings,
-                          progress=lambda line: print(f'ttb-sim: identify: {line}',
-                                                      file=sys.stderr, flush=True))
-        summary = result.summary()
-        summary.update(bag=str(path), scenario=model.scenario, overrides=list(model.overrides),
-                       sensors=[s.name for s in model.sensors],
-                       features=result.observation.names,
-                       psd_grid={'fmin_hz': model.spec.psd_fmin_hz,
-                                 'fmax_hz': model.spec.psd_fmax_hz,
-                                 'points': model.spec.psd_points,
-                                 'segment_s': model.spec.psd_segment_s},
-                       wall_time_s=time.perf_counter() - start)
-        _write(stage, path, result, summary)
+    try:
+        with SignalHandlers() as handlers, staged_output(target) as stage:
+            if threading.current_thread() is threading.main_thread():
+                handlers.install(raise_stopped)   # unwind: the staging folder is removed
+            summary = _identify(path, stage, scenario, overrides, keys, sensors, fmin, fmax,
+                                points, segment, priors, settings, workers, scheduler, start,
+                                target)
+    except Stopped as stop:
+        print(f'ttb-sim: stopped by {signal_name(stop.signum)}; nothing written',
+              file=sys.stderr)
+        return 128 + stop.signum
     _report(target, summary)
     return EXIT_OK
+
+
+def _identify(path: Path, stage: Path, scenario: str | None, overrides: Sequence[str],
+              keys: Sequence[str], sensors: str | None, fmin: float | None,
+              fmax: float | None, points: int, segment: float | None, priors: Sequence[Any],
+              settings: Any, workers: int | None, scheduler: str | None,
+              start: float, target: Path) -> dict[str, Any]:
+    """Set up, run the design on the pool, sample; write the files; return the summary."""
+    from ttb_sim.twin.identify import identify
+    model, observed, record = _set_up(path, stage, scenario, overrides, keys, sensors,
+                                      fmin, fmax, points, segment, priors)
+    n_design = settings.design or 8 * len(keys) + 8
+    print(f'ttb-sim: identify: {len(keys)} parameter(s) from {len(model.sensors)} '
+          f'sensor(s), {record:.3g} s recorded; design of {n_design} runs', file=sys.stderr)
+    with PoolRunner(n_design, workers, scheduler) as runner:
+        result = identify(model, priors, observed, record, settings,
+                          progress=lambda line: print(f'ttb-sim: identify: {line}',
+                                                      file=sys.stderr, flush=True),
+                          runner=runner)
+    summary = result.summary()
+    staged = Path(model.scenario) == stage.resolve() / MODEL_SCENARIO
+    summary.update(bag=str(path), scenario=str(target / MODEL_SCENARIO) if staged else
+                   model.scenario, overrides=list(model.overrides),
+                   sensors=[s.name for s in model.sensors],
+                   features=result.observation.names,
+                   psd_grid={'fmin_hz': model.spec.psd_fmin_hz,
+                             'fmax_hz': model.spec.psd_fmax_hz,
+                             'points': model.spec.psd_points,
+                             'segment_s': model.spec.psd_segment_s},
+                   wall_time_s=time.perf_counter() - start)
+    _write(stage, path, result, summary)
+    return summary
+
+
+class PoolRunner:
+    """
+    The design runs of :func:`~ttb_sim.twin.identify.identify` on the pool of ``dataset``.
+
+    A runner of :meth:`~ttb_sim.twin.forward.ForwardModel.evaluate_many`: local worker
+    processes (``workers``; default one per core, at most one per run; each runs its
+    kernels on one thread when there are several) or a Dask cluster (``scheduler``).
+    One design per runner.  A signal stops the workers and raises
+    :class:`~ttb_sim.commands.signals.Stopped`.
+    """
+
+    def __init__(self, n_runs: int, workers: int | None = None,
+                 scheduler: str | None = None) -> None:
+        from ttb_sim.twin.forward import run_design
+        check_workers(workers, scheduler)
+        self.pool: Any = make_pool(run_design, n_runs, workers, scheduler)
+        self.used = False
+
+    def __call__(self, runs: Sequence[Any], on_record: Any) -> None:
+        """Run the runs, handing each record to ``on_record`` as it finishes."""
+        if self.used:
+            raise RuntimeError('a PoolRunner runs one design')
+        self.used = True   # run_cases closes the pool (or stops it on a signal)
+        stop = run_cases(self.pool, runs, _lost, 'identify', on_record, case_lines=False)
+        if stop is not None:
+            raise stop
+
+    def __enter__(self) -> PoolRunner:
+        """Return the runner."""
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        """Close the pool if no design ran on it."""
+        if not self.used:   # nothing was run (refused before the design): no worker started
+            self.pool.close()
+
+
+def _lost(run: Any, error: BaseException) -> dict[str, Any]:
+    """Return the failed record of a design run whose worker died."""
+    return {'status': 'failed', 'error': f'worker lost: {type(error).__name__}: {error}'}
 
 
 def _check_out(target: Path) -> None:

@@ -46,6 +46,8 @@ SCHEDULER_TIMEOUT_S = 10.0
 """How long to wait for a Dask scheduler before giving up (exit 2)."""
 MAX_WORKERS = 1024
 """Most local worker processes."""
+STOP_GRACE_S = 10.0
+"""Seconds a terminated worker has to exit before the pool shuts down without it."""
 
 
 class NamedCase(Protocol):
@@ -114,9 +116,12 @@ class LocalPool(Generic[Case]):
 
     def stop(self) -> None:
         """Terminate the workers at once (their cases are unfinished: redone next time)."""
-        for process in list(getattr(self.pool, '_processes', {}).values()):
+        processes = list(getattr(self.pool, '_processes', {}).values())
+        for process in processes:
             process.terminate()
-        self.pool.shutdown(wait=False, cancel_futures=True)
+        for process in processes:   # reaped, so that their queues' semaphores are released
+            process.join(STOP_GRACE_S)
+        self.pool.shutdown(wait=True, cancel_futures=True)
 
 
 class DaskPool(Generic[Case]):
@@ -182,11 +187,13 @@ def make_pool(run: Callable[[Case], Record], n_cases: int, workers: int | None,
 
 def run_cases(pool: LocalPool[Case] | DaskPool[Case], cases: Sequence[Case],
               lost: Callable[[Case, BaseException], Record], verb: str,
-              on_record: Callable[[Case, Record], None]) -> Stopped | None:
+              on_record: Callable[[Case, Record], None],
+              case_lines: bool = True) -> Stopped | None:
     """
     Run the cases on the pool, handing each record to ``on_record`` as it comes.
 
-    Prints a progress line per case to stderr (``[3/20] case ok in 12.5 s``).
+    Prints a progress line per case to stderr (``[3/20] case ok in 12.5 s``), unless
+    ``case_lines`` is False (``on_record`` prints its own).
     Returns the :class:`Stopped` of a SIGINT/SIGTERM (the pool is then stopped),
     or None when every case came back.
     """
@@ -202,6 +209,8 @@ def run_cases(pool: LocalPool[Case] | DaskPool[Case], cases: Sequence[Case],
         for i, (case, outcome) in enumerate(pool.results(), start=1):
             record = lost(case, outcome) if isinstance(outcome, BaseException) else outcome
             on_record(case, record)
+            if not case_lines:
+                continue
             detail = f'in {record.get("wall_time_s", 0.0) or 0.0:.1f} s' \
                 if record['status'] == 'ok' else f'{record["status"]}: {record.get("error")}'
             print(f'ttb-sim: {verb}: [{i}/{len(cases)}] {case.name} {record["status"]} '

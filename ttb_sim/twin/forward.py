@@ -35,6 +35,16 @@ a hash of their inputs (:mod:`ttb_sim.model.foundation.operator_cache`), so a
 parameter of the girders, bearings, train or environment reuses the substructure's
 basis; a parameter of the soil or piles builds it once per new value.
 
+Many cases: :meth:`ForwardModel.evaluate_many` runs one :class:`DesignRun` per row
+of ``theta`` through a *runner*, by default one after another in this process.  A
+runner is any function that runs the picklable :class:`DesignRun` records with the
+top-level :func:`run_design` (in worker processes, on a cluster) and hands each
+record back as it finishes, in any order: the records come back in the order of the
+rows, and :func:`run_design` is deterministic, so the results do not depend on the
+runner.  ``ttb-sim identify --workers/--scheduler`` passes the pool of
+:mod:`ttb_sim.commands.pool` this way (the twin layer stays free of processes,
+signals and Dask).
+
 The feature vector is, per channel (``<sensor>.<axis>``, in the sensors' order),
 log10 of its PSD at the grid points every channel resolves (below the lowest
 sensor Nyquist frequency), then, when asked, its RMS: a log spectrum is what the
@@ -47,14 +57,17 @@ from dataclasses import dataclass
 import logging
 from pathlib import Path
 import tempfile
-from typing import Any, Sequence
+import time
+from typing import Any, Callable, Sequence
 
 import numpy as np
 
-from ttb_sim.errors import ScenarioError, SimulationError
+from ttb_sim.errors import ScenarioError, SimulationError, TtbSimError
 from ttb_sim.twin.features import Features, FeatureSpec
 
-__all__ = ['FeatureVector', 'ForwardModel', 'noiseless']
+__all__ = ['DesignRun', 'evaluate_many', 'FeatureVector', 'ForwardModel', 'in_process',
+           'noiseless',
+           'OnRecord', 'run_design', 'Runner']
 
 log = logging.getLogger(__name__)
 
@@ -195,6 +208,100 @@ class ForwardModel:
         if array.ndim == 2:
             return np.stack([self(row) for row in array])
         return self.vector.of(self.simulate(array))
+
+    def evaluate_many(self, thetas: Sequence[Sequence[float]] | np.ndarray,
+                      runner: Runner | None = None,
+                      on_record: OnRecord | None = None) -> list[dict[str, Any]]:
+        """
+        Run one case per row of ``thetas``; return their records in the order of the rows.
+
+        Parameters
+        ----------
+        thetas
+            (n, d) parameter values, one case per row.
+        runner
+            Runs the :class:`DesignRun` records with :func:`run_design` and hands each
+            ``(run, record)`` to its callback as it finishes (default :func:`in_process`).
+        on_record
+            Called with each ``(run, record)`` as it finishes (progress).
+
+        Returns
+        -------
+        list of dict
+            Per row: ``status`` ('ok' with ``vector``, or 'failed' with ``error``) and
+            ``wall_time_s``.  A failing case is recorded and the others go on.
+
+        """
+        rows = np.atleast_2d(np.asarray(thetas, dtype=float))
+        for row in rows:
+            self.values(row)   # the shape, before any run
+        return evaluate_many(self, rows, runner, on_record)
+
+
+@dataclass(frozen=True)
+class DesignRun:
+    """One case of :meth:`ForwardModel.evaluate_many`: picklable, for any process."""
+
+    name: str
+    """``design007``: unique in its design."""
+    index: int
+    """Its row in the design."""
+    model: Callable[[np.ndarray], np.ndarray]
+    """The model (a :class:`ForwardModel`): ``model(theta)`` is the run."""
+    theta: tuple[float, ...]
+
+
+OnRecord = Callable[[DesignRun, dict[str, Any]], None]
+"""Takes a finished run and its record."""
+Runner = Callable[[Sequence[DesignRun], OnRecord], None]
+"""Runs the runs with :func:`run_design`, handing each record on as it finishes."""
+
+
+def run_design(run: DesignRun) -> dict[str, Any]:
+    """
+    Run one case; return its record (never raises for a case the model refuses).
+
+    ``status`` 'ok' with ``vector`` (the feature vector), or 'failed' with ``error``
+    (a value the scenario refuses, a run that diverged); and ``wall_time_s``.
+    """
+    start = time.perf_counter()
+    try:
+        vector = run.model(np.array(run.theta))
+    except TtbSimError as exc:   # a case refused or diverged: recorded, the others go on
+        return {'status': 'failed', 'error': str(exc),
+                'wall_time_s': time.perf_counter() - start}
+    return {'status': 'ok', 'vector': vector, 'wall_time_s': time.perf_counter() - start}
+
+
+def evaluate_many(model: Callable[[np.ndarray], np.ndarray],
+                  thetas: Sequence[Sequence[float]] | np.ndarray, runner: Runner | None = None,
+                  on_record: OnRecord | None = None) -> list[dict[str, Any]]:
+    """
+    Run ``model`` at each row of ``thetas``; return the records in the order of the rows.
+
+    :meth:`ForwardModel.evaluate_many` for any model (a function of ``theta``;
+    picklable for a runner in other processes).
+    """
+    rows = np.atleast_2d(np.asarray(thetas, dtype=float))
+    runs = [DesignRun(f'design{i:03d}', i, model, tuple(float(v) for v in row))
+            for i, row in enumerate(rows)]
+    records: dict[int, dict[str, Any]] = {}
+
+    def take(run: DesignRun, record: dict[str, Any]) -> None:
+        records[run.index] = record
+        if on_record is not None:
+            on_record(run, record)
+    (runner or in_process)(runs, take)
+    missing = [r.name for r in runs if r.index not in records]
+    if missing:
+        raise SimulationError(f'the runner returned no record for {", ".join(missing)}')
+    return [records[r.index] for r in runs]
+
+
+def in_process(runs: Sequence[DesignRun], on_record: OnRecord) -> None:
+    """Run the runs one after another in this process (the default runner)."""
+    for run in runs:
+        on_record(run, run_design(run))
 
 
 def noiseless(scenario: Any) -> Any:

@@ -60,7 +60,7 @@ import numpy as np
 from ttb_sim.config.sensor_records import SensorConfig
 from ttb_sim.errors import ScenarioError, SimulationError, TtbSimError
 from ttb_sim.twin.features import Features, FeatureSpec
-from ttb_sim.twin.forward import ForwardModel
+from ttb_sim.twin.forward import DesignRun, evaluate_many, ForwardModel, Runner
 from ttb_sim.twin.priors import Prior, unit_design
 
 __all__ = ['data_grid', 'Identification', 'identify', 'IdentifySettings', 'Observation',
@@ -321,7 +321,8 @@ def _cdf(prior: Prior, values: np.ndarray) -> np.ndarray:
 
 def identify(model: ForwardModel, priors: Sequence[Prior], observed: Features,
              record_s: float, settings: IdentifySettings | None = None,
-             progress: Callable[[str], None] | None = None) -> Identification:
+             progress: Callable[[str], None] | None = None,
+             runner: Runner | None = None) -> Identification:
     """
     Update the priors of ``model``'s keys from a recorded passage's features.
 
@@ -338,7 +339,11 @@ def identify(model: ForwardModel, priors: Sequence[Prior], observed: Features,
     settings
         Design size, sampler, seed, discrepancy.
     progress
-        Called with one line per design run.
+        Called with one line per design run, as each finishes.
+    runner
+        Runs the design (:meth:`ForwardModel.evaluate_many`); default one run after
+        another in this process.  Any runner gives the same result bit for bit: the
+        design, its order and each run are deterministic.
 
     Raises
     ------
@@ -360,18 +365,26 @@ def identify(model: ForwardModel, priors: Sequence[Prior], observed: Features,
     observation = Observation.of(model, observed, record_s)
     n_design = settings.design or 8 * d + 8
     u_design = unit_design(n_design, d, 'sobol', settings.seed)
-    thetas, vectors, failed = [], [], []
-    for i, u in enumerate(u_design):
-        theta = np.array([p.quantile(np.array([x]))[0] for p, x in zip(priors, u)])
-        outcome = 'ok'
-        try:
-            vectors.append(model(theta))
-            thetas.append(theta)
-        except TtbSimError as exc:   # a case refused or diverged: recorded, the others go on
-            failed.append(f'{_shown(model.keys, theta)}: {exc}')
-            outcome = 'failed'
+    design = np.array([[p.quantile(np.array([x]))[0] for p, x in zip(priors, u)]
+                       for u in u_design])
+    finished = 0
+
+    def report(run: DesignRun, record: dict[str, Any]) -> None:
+        nonlocal finished
+        finished += 1
         if progress is not None:
-            progress(f'design run {i + 1}/{n_design} at {_shown(model.keys, theta)}: {outcome}')
+            outcome = f'ok in {record.get("wall_time_s") or 0.0:.1f} s' \
+                if record['status'] == 'ok' else f'{record["status"]}: {record.get("error")}'
+            progress(f'design run {finished}/{n_design} ({run.name}) at '
+                     f'{_shown(model.keys, np.array(run.theta))}: {outcome}')
+    records = evaluate_many(model, design, runner, report)
+    thetas, vectors, failed = [], [], []
+    for theta, record in zip(design, records):   # in design order, whatever finished first
+        if record['status'] == 'ok':
+            vectors.append(np.asarray(record['vector']))
+            thetas.append(theta)
+        else:   # a case refused or diverged (or its worker lost): the others go on
+            failed.append(f'{_shown(model.keys, theta)}: {record.get("error")}')
     if len(thetas) < d + 3:
         raise SimulationError(f'only {len(thetas)} of {n_design} design runs succeeded (at '
                               f'least {d + 3} needed): {"; ".join(failed[:3])}')
