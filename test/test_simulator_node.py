@@ -354,3 +354,35 @@ def test_without_tf2_msgs_the_node_runs_without_tf(monkeypatch):
         wait_for(lambda: h.node.publish_loop is not None)   # built and publishing
     finally:
         h.close()
+
+
+def test_sensors_and_damage_in_the_node_bag(tmp_path):
+    """A sensor layout and a damage state: sensor topics at their rates, the labels, in MCAP."""
+    from ttb_sim.config import load_scenario
+    sensed = load_scenario('moving_force_beam', [
+        'output.rate_hz=1000', 'solver.duration=0.4',
+        'sensors=[{name: mid, type: accelerometer, at: "span01/x=16.0", axes: [z], '
+        'rate_hz: 250, noise_density: 0.02, seed: 11}]',
+        'damage.girders=[{span: 1, start: 9.0, length: 6.0, loss: 0.35}]'])
+    source = tmp_path / 'sensed.yaml'
+    source.write_text(yaml.safe_dump(sensed.echo(), sort_keys=False))
+    path = tmp_path / 'bag'
+    h = Harness(scenario=str(source), real_time_factor=0.0, loop=False,
+                **{'bag.enabled': True, 'bag.path': str(path)})
+    try:
+        wait_for(lambda: h.node.controller is not None and h.node.controller.state == 'idle')
+    finally:
+        h.close()
+    with AnyReader([path]) as reader:
+        topic = '/ttb_sim/sensors/mid'
+        conns = [c for c in reader.connections if c.topic == topic]
+        assert [c.msgtype for c in conns] == ['sensor_msgs/msg/Imu']
+        msgs = [reader.deserialize(raw, c.msgtype) for c, _, raw in reader.messages(conns)]
+        labels = [json.loads(reader.deserialize(raw, c.msgtype).data)
+                  for c, _, raw in reader.messages() if c.topic == LABELS_TOPIC]
+    stamps = [m.header.stamp.sec * 10**9 + m.header.stamp.nanosec for m in msgs]
+    assert len(stamps) >= 90 and {b - a for a, b in zip(stamps, stamps[1:])} == {4_000_000}
+    values = [m.linear_acceleration.z for m in msgs]
+    assert max(values) != min(values) and all(math.isfinite(v) for v in values)
+    assert labels[-1]['damage']['girders'] == [
+        {'span': 1, 'start': 9.0, 'length': 6.0, 'loss': 0.35}]
