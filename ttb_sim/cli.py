@@ -230,6 +230,8 @@ def _add_bag_verbs(sub: Any) -> None:
     idn.add_argument('--fmin', type=float, help='lowest PSD frequency (default 1 / segment)')
     idn.add_argument('--fmax', type=float, help='highest (default 0.8 x the lowest sensor '
                      'Nyquist frequency)')
+    idn.add_argument('--refine', type=int, default=0, metavar='N',
+                     help='N more runs over the first posterior, then sample again (default 0)')
     idn.add_argument('--points', type=int, default=48, help='PSD grid points (default 48)')
     idn.add_argument('--segment', type=float, help='Welch segment, s (default min(2, record/4))')
     where = idn.add_mutually_exclusive_group()
@@ -352,7 +354,8 @@ def _main(argv: Sequence[str] | None) -> int:
                                     seed=args.seed, discrepancy=args.discrepancy,
                                     fmin=args.fmin, fmax=args.fmax, points=args.points,
                                     segment=args.segment, response=args.response,
-                                    workers=args.workers, scheduler=args.scheduler)
+                                    workers=args.workers, scheduler=args.scheduler,
+                                    refine=args.refine)
         if args.command == 'bench':
             from ttb_sim.commands.bench import bench_command
             return bench_command(args.scenarios, variants=args.variants,

@@ -71,6 +71,7 @@ def test_a_hidden_loss_from_the_bag_alone(observed, tmp_path, capsys):
     ([*ARGS, '--steps', '5'], '--steps 5'),
     ([], 'at least one --param'),
     ([*ARGS, '--workers', '0'], '--workers 0 must be from 1 to'),
+    ([*ARGS, '--refine', '-1'], '--refine -1 must be an integer from 0'),
 ])
 def test_bad_input_exits_2_in_one_line_and_writes_nothing(observed, tmp_path, capsys, args,
                                                           words):
@@ -99,8 +100,8 @@ def test_the_design_is_the_same_bits_on_one_or_two_workers():
     assert 'damage.girders[0].loss = 2.0' in here[1]['error']
     for workers in (1, 2):
         seen = []
-        with PoolRunner(len(thetas), workers) as runner:
-            there = model.evaluate_many(thetas, runner, lambda run, r: seen.append(run.index))
+        there = model.evaluate_many(thetas, PoolRunner(workers),
+                                    lambda run, r: seen.append(run.index))
         assert sorted(seen) == [0, 1, 2]
         assert [r['status'] for r in there] == ['ok', 'failed', 'ok']
         for a, b in zip(here, there):
@@ -110,6 +111,7 @@ def test_the_design_is_the_same_bits_on_one_or_two_workers():
 @pytest.mark.parametrize('sig, code, at', [
     (signal.SIGTERM, 143, 'design of'),         # setting up (the bag read, the model built)
     (signal.SIGINT, 130, 'design run 1/'),      # the design running on two workers
+    (signal.SIGTERM, 143, 'design run 12/12'),  # sampling the posterior
 ])
 def test_a_signal_stops_the_workers_and_writes_nothing(observed, tmp_path, sig, code, at):
     out = tmp_path / 'id'
@@ -132,3 +134,14 @@ def test_a_signal_stops_the_workers_and_writes_nothing(observed, tmp_path, sig, 
         f'ttb-sim: stopped by {signal.Signals(sig).name}; nothing written', err
     assert 'Traceback' not in err
     assert list(tmp_path.iterdir()) == []   # no folder, no staging folder left behind
+
+
+def test_a_second_design_over_the_first_posterior(observed, tmp_path):
+    out = tmp_path / 'id'
+    assert main(['identify', str(observed), *ARGS, '--refine', '6', '--out', str(out)]) == 0
+    posterior = json.loads((out / 'posterior.json').read_text())
+    assert posterior['diagnostics']['design_runs'] == 8 + 6
+    loss = posterior['parameters']['damage.girders[0].loss']
+    assert loss['q05'] <= 0.3 <= loss['q95'] and abs(loss['median'] - 0.3) < 0.05
+    refined = np.load(out / 'chains.npz')['design_theta'][8:, 0]
+    assert np.all(np.abs(refined - 0.3) < 0.15)   # the prior is U(0, 0.6): drawn near 0.3

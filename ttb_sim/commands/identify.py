@@ -19,7 +19,7 @@ The ``identify`` verb: Bayesian updating of scenario keys from a recorded passag
 ``ttb-sim identify BAG --param KEY=uniform:A,B [--param ...] --out DIR
 [--scenario SCENARIO] [--set KEY=VALUE ...] [--sensors a,b] [--design N] [--steps N]
 [--walkers N] [--seed N] [--discrepancy X] [--fmin HZ] [--fmax HZ] [--points N]
-[--segment S] [--workers N | --scheduler ADDRESS]``
+[--segment S] [--refine N] [--workers N | --scheduler ADDRESS]``
 
 The model to update is ``--scenario`` (with ``--set``), or by default the scenario the
 bag was recorded from (stored in its metadata by ``ttb-sim run``; a bag recorded
@@ -49,7 +49,7 @@ from typing import Any, Sequence
 import numpy as np
 
 from ttb_sim.commands.pool import check_workers, make_pool, run_cases
-from ttb_sim.commands.signals import raise_stopped, signal_name, SignalHandlers, Stopped
+from ttb_sim.commands.signals import signal_name, SignalHandlers, StopFlag, Stopped
 from ttb_sim.errors import ScenarioError
 from ttb_sim.inputs import shown
 
@@ -102,7 +102,8 @@ def identify_command(bag: str | Path, params: Sequence[str], *, out: str | Path 
                      walkers: int = 0, seed: int = 0, discrepancy: float = 0.02,
                      fmin: float | None = None, fmax: float | None = None, points: int = 48,
                      segment: float | None = None, response: str = 'passage',
-                     workers: int | None = None, scheduler: str | None = None) -> int:
+                     workers: int | None = None, scheduler: str | None = None,
+                     refine: int = 0) -> int:
     """Run ``ttb-sim identify``; return the exit code."""
     from ttb_sim.io.bag_checks import check_bag_path
     from ttb_sim.report.output import staged_output
@@ -119,7 +120,7 @@ def identify_command(bag: str | Path, params: Sequence[str], *, out: str | Path 
     if len(set(keys)) != len(keys):
         raise ScenarioError(f'--param names a key twice ({", ".join(keys)})')
     settings = IdentifySettings(design=design, walkers=walkers, steps=steps, seed=seed,
-                                discrepancy=discrepancy, response=response)
+                                discrepancy=discrepancy, response=response, refine=refine)
     check_bag_path(path)
     target = Path(out) if out is not None else \
         (path if path.is_dir() else path.parent) / 'identify'
@@ -127,7 +128,8 @@ def identify_command(bag: str | Path, params: Sequence[str], *, out: str | Path 
     try:
         with SignalHandlers() as handlers, staged_output(target) as stage:
             if threading.current_thread() is threading.main_thread():
-                handlers.install(raise_stopped)   # unwind: the staging folder is removed
+                handlers.install(STOP)   # a flag, read between the stages (never raised
+                # inside a library call, which could swallow it)
             summary = _identify(path, stage, scenario, overrides, keys, sensors, fmin, fmax,
                                 points, segment, priors, settings, workers, scheduler, start,
                                 target)
@@ -148,14 +150,16 @@ def _identify(path: Path, stage: Path, scenario: str | None, overrides: Sequence
     from ttb_sim.twin.identify import identify
     model, observed, record = _set_up(path, stage, scenario, overrides, keys, sensors,
                                       fmin, fmax, points, segment, priors)
+    stop_if_asked()
     n_design = settings.design or 8 * len(keys) + 8
     print(f'ttb-sim: identify: {len(keys)} parameter(s) from {len(model.sensors)} '
-          f'sensor(s), {record:.3g} s recorded; design of {n_design} runs', file=sys.stderr)
-    with PoolRunner(n_design, workers, scheduler) as runner:
-        result = identify(model, priors, observed, record, settings,
-                          progress=lambda line: print(f'ttb-sim: identify: {line}',
-                                                      file=sys.stderr, flush=True),
-                          runner=runner)
+          f'sensor(s), {record:.3g} s recorded; design of {n_design} runs'
+          + (f', then {settings.refine} over the first posterior' if settings.refine else ''),
+          file=sys.stderr)
+    result = identify(model, priors, observed, record, settings,
+                      progress=lambda line: print(f'ttb-sim: identify: {line}',
+                                                  file=sys.stderr, flush=True),
+                      runner=PoolRunner(workers, scheduler))
     summary = result.summary()
     staged = Path(model.scenario) == stage.resolve() / MODEL_SCENARIO
     summary.update(bag=str(path), scenario=str(target / MODEL_SCENARIO) if staged else
@@ -167,6 +171,7 @@ def _identify(path: Path, stage: Path, scenario: str | None, overrides: Sequence
                              'points': model.spec.psd_points,
                              'segment_s': model.spec.psd_segment_s},
                    wall_time_s=time.perf_counter() - start)
+    stop_if_asked()
     _write(stage, path, result, summary)
     return summary
 
@@ -178,34 +183,37 @@ class PoolRunner:
     A runner of :meth:`~ttb_sim.twin.forward.ForwardModel.evaluate_many`: local worker
     processes (``workers``; default one per core, at most one per run; each runs its
     kernels on one thread when there are several) or a Dask cluster (``scheduler``).
-    One design per runner.  A signal stops the workers and raises
+    A pool per design (its workers end with it).  A signal stops the workers and raises
     :class:`~ttb_sim.commands.signals.Stopped`.
     """
 
-    def __init__(self, n_runs: int, workers: int | None = None,
-                 scheduler: str | None = None) -> None:
-        from ttb_sim.twin.forward import run_design
+    def __init__(self, workers: int | None = None, scheduler: str | None = None) -> None:
         check_workers(workers, scheduler)
-        self.pool: Any = make_pool(run_design, n_runs, workers, scheduler)
-        self.used = False
+        self.workers, self.scheduler = workers, scheduler
 
     def __call__(self, runs: Sequence[Any], on_record: Any) -> None:
-        """Run the runs, handing each record to ``on_record`` as it finishes."""
-        if self.used:
-            raise RuntimeError('a PoolRunner runs one design')
-        self.used = True   # run_cases closes the pool (or stops it on a signal)
-        stop = run_cases(self.pool, runs, _lost, 'identify', on_record, case_lines=False)
-        if stop is not None:
+        """Run the runs on a new pool, handing each record to ``on_record`` as it finishes."""
+        from ttb_sim.twin.forward import run_design
+        stop_if_asked()
+        pool = make_pool(run_design, len(runs), self.workers, self.scheduler)
+
+        def take(run: Any, record: dict[str, Any]) -> None:
+            on_record(run, record)
+            stop_if_asked()   # a signal during the submission: stop at the first record
+        stop = run_cases(pool, runs, _lost, 'identify', take, case_lines=False)
+        if stop is not None:   # run_cases stopped the pool
             raise stop
 
-    def __enter__(self) -> PoolRunner:
-        """Return the runner."""
-        return self
 
-    def __exit__(self, *exc: object) -> None:
-        """Close the pool if no design ran on it."""
-        if not self.used:   # nothing was run (refused before the design): no worker started
-            self.pool.close()
+STOP = StopFlag()
+STOP.setup = False   # a signal sets the flag; stop_if_asked raises it where it is safe
+
+
+def stop_if_asked() -> None:
+    """Raise :class:`Stopped` if SIGINT or SIGTERM arrived (and clear the flag)."""
+    signum, STOP.signal = STOP.signal, None
+    if signum is not None:
+        raise Stopped(signum)
 
 
 def _lost(run: Any, error: BaseException) -> dict[str, Any]:

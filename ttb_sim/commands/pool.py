@@ -185,6 +185,19 @@ def make_pool(run: Callable[[Case], Record], n_cases: int, workers: int | None,
     return LocalPool(workers or max(1, min(n_cases, os.cpu_count() or 1)), run)
 
 
+def _close_whole(pool: LocalPool[Any] | DaskPool[Any], main_thread: bool) -> None:
+    """Close the pool with SIGINT/SIGTERM held back: a signal then arrives after it."""
+    if not main_thread:
+        pool.close()
+        return
+    held = {signal.SIGINT, signal.SIGTERM}
+    signal.pthread_sigmask(signal.SIG_BLOCK, held)
+    try:
+        pool.close()
+    finally:
+        signal.pthread_sigmask(signal.SIG_UNBLOCK, held)
+
+
 def run_cases(pool: LocalPool[Case] | DaskPool[Case], cases: Sequence[Case],
               lost: Callable[[Case, BaseException], Record], verb: str,
               on_record: Callable[[Case, Record], None],
@@ -215,7 +228,7 @@ def run_cases(pool: LocalPool[Case] | DaskPool[Case], cases: Sequence[Case],
                 if record['status'] == 'ok' else f'{record["status"]}: {record.get("error")}'
             print(f'ttb-sim: {verb}: [{i}/{len(cases)}] {case.name} {record["status"]} '
                   f'{detail}', file=sys.stderr, flush=True)
-        pool.close()
+        _close_whole(pool, main_thread)
     except Stopped as stop:
         pool.stop()
         return stop

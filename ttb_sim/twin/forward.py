@@ -275,15 +275,16 @@ def run_design(run: DesignRun) -> dict[str, Any]:
 
 def evaluate_many(model: Callable[[np.ndarray], np.ndarray],
                   thetas: Sequence[Sequence[float]] | np.ndarray, runner: Runner | None = None,
-                  on_record: OnRecord | None = None) -> list[dict[str, Any]]:
+                  on_record: OnRecord | None = None, first: int = 0) -> list[dict[str, Any]]:
     """
     Run ``model`` at each row of ``thetas``; return the records in the order of the rows.
 
     :meth:`ForwardModel.evaluate_many` for any model (a function of ``theta``;
-    picklable for a runner in other processes).
+    picklable for a runner in other processes).  The runs are named from
+    ``design{first:03d}`` on (a second design goes on from the first's count).
     """
     rows = np.atleast_2d(np.asarray(thetas, dtype=float))
-    runs = [DesignRun(f'design{i:03d}', i, model, tuple(float(v) for v in row))
+    runs = [DesignRun(f'design{first + i:03d}', i, model, tuple(float(v) for v in row))
             for i, row in enumerate(rows)]
     records: dict[int, dict[str, Any]] = {}
 

@@ -90,11 +90,14 @@ class IdentifySettings:
     flat_ratio: float = 0.7
     response: str = 'passage'
     """'passage' (deterministic response plus sensor noise) or 'ambient' (random response)."""
+    refine: int = 0
+    """Forward runs of a second design over the first posterior's box (0: none)."""
 
     def __post_init__(self) -> None:
         """Refuse settings that cannot run."""
         checks = [('design', self.design, 0, 10_000), ('walkers', self.walkers, 0, 10_000),
-                  ('steps', self.steps, 100, 10_000_000), ('seed', self.seed, 0, 2 ** 32 - 1)]
+                  ('steps', self.steps, 100, 10_000_000), ('seed', self.seed, 0, 2 ** 32 - 1),
+                  ('refine', self.refine, 0, 10_000)]
         for name, value, low, high in checks:
             if not (isinstance(value, int) and low <= value <= high):
                 raise ScenarioError(f'--{name} {value!r} must be an integer from {low} to {high}')
@@ -353,7 +356,6 @@ def identify(model: ForwardModel, priors: Sequence[Prior], observed: Features,
         When too few design runs succeed to fit the surrogate.
 
     """
-    import emcee
     settings = settings or IdentifySettings()
     d = len(priors)
     if [p.key for p in priors] != list(model.keys):
@@ -365,31 +367,83 @@ def identify(model: ForwardModel, priors: Sequence[Prior], observed: Features,
     observation = Observation.of(model, observed, record_s)
     n_design = settings.design or 8 * d + 8
     u_design = unit_design(n_design, d, 'sobol', settings.seed)
-    design = np.array([[p.quantile(np.array([x]))[0] for p, x in zip(priors, u)]
-                       for u in u_design])
-    finished = 0
+    runs = _DesignRuns(model, priors, runner, progress, n_design + settings.refine)
+    runs.run(u_design)
+    if len(runs.thetas) < d + 3:
+        raise SimulationError(f'only {len(runs.thetas)} of {n_design} design runs succeeded (at '
+                              f'least {d + 3} needed): {"; ".join(runs.failed[:3])}')
+    fit = _sample(observation, priors, runs, settings)
+    if settings.refine:   # a second design over the first posterior's box, then again
+        runs.run(_refined_design(fit.flat_u, settings.refine, settings.seed))
+        fit = _sample(observation, priors, runs, settings)
+    samples = np.column_stack([np.array(p.quantile(fit.flat_u[:, j]))
+                               for j, p in enumerate(priors)])
+    chain = np.stack([np.array(p.quantile(fit.chain_u[:, :, j].ravel())).reshape(
+        fit.chain_u.shape[:2]) for j, p in enumerate(priors)], axis=-1)
+    result = Identification(tuple(priors), samples, chain, fit.sampler.get_log_prob(),
+                            float(np.mean(fit.sampler.acceptance_fraction)), fit.tau,
+                            fit.burn, fit.thin, np.array(runs.thetas), fit.z, observation,
+                            fit.surrogate.cv_rmse, failed_design=runs.failed, settings=settings)
+    result.check, result.median_z = _check_median(model, priors, observation, fit.surrogate,
+                                                  samples)
+    return result
 
-    def report(run: DesignRun, record: dict[str, Any]) -> None:
-        nonlocal finished
-        finished += 1
-        if progress is not None:
+
+class _DesignRuns:
+    """The forward runs of the surrogate's designs, in design order, and their progress."""
+
+    def __init__(self, model: ForwardModel, priors: Sequence[Prior], runner: Runner | None,
+                 progress: Callable[[str], None] | None, total: int) -> None:
+        self.model, self.priors, self.runner, self.progress = model, priors, runner, progress
+        self.total = total
+        self.finished = 0
+        self.thetas: list[np.ndarray] = []
+        self.vectors: list[np.ndarray] = []
+        self.failed: list[str] = []
+
+    def run(self, u_design: np.ndarray) -> None:
+        """Run the design of ``u_design`` (probability scale); keep what succeeded."""
+        design = np.array([[p.quantile(np.array([x]))[0] for p, x in zip(self.priors, u)]
+                           for u in u_design])
+        records = evaluate_many(self.model, design, self.runner, self._report,
+                                first=len(self.thetas) + len(self.failed))
+        for theta, record in zip(design, records):   # design order, whatever finished first
+            if record['status'] == 'ok':
+                self.vectors.append(np.asarray(record['vector']))
+                self.thetas.append(theta)
+            else:   # a case refused or diverged (or its worker lost): the others go on
+                self.failed.append(f'{_shown(self.model.keys, theta)}: {record.get("error")}')
+
+    def _report(self, run: DesignRun, record: dict[str, Any]) -> None:
+        self.finished += 1
+        if self.progress is not None:
             outcome = f'ok in {record.get("wall_time_s") or 0.0:.1f} s' \
                 if record['status'] == 'ok' else f'{record["status"]}: {record.get("error")}'
-            progress(f'design run {finished}/{n_design} ({run.name}) at '
-                     f'{_shown(model.keys, np.array(run.theta))}: {outcome}')
-    records = evaluate_many(model, design, runner, report)
-    thetas, vectors, failed = [], [], []
-    for theta, record in zip(design, records):   # in design order, whatever finished first
-        if record['status'] == 'ok':
-            vectors.append(np.asarray(record['vector']))
-            thetas.append(theta)
-        else:   # a case refused or diverged (or its worker lost): the others go on
-            failed.append(f'{_shown(model.keys, theta)}: {record.get("error")}')
-    if len(thetas) < d + 3:
-        raise SimulationError(f'only {len(thetas)} of {n_design} design runs succeeded (at '
-                              f'least {d + 3} needed): {"; ".join(failed[:3])}')
-    design_theta = np.array(thetas)
-    z = observation.observable(np.array(vectors))
+            self.progress(f'design run {self.finished}/{self.total} ({run.name}) at '
+                          f'{_shown(self.model.keys, np.array(run.theta))}: {outcome}')
+
+
+@dataclass
+class _Fit:
+    """A surrogate fitted to the design runs and the chain sampled on it."""
+
+    z: np.ndarray
+    surrogate: Surrogate
+    sampler: Any
+    chain_u: np.ndarray
+    flat_u: np.ndarray
+    tau: np.ndarray
+    burn: int
+    thin: int
+
+
+def _sample(observation: Observation, priors: Sequence[Prior], runs: _DesignRuns,
+            settings: IdentifySettings) -> _Fit:
+    """Fit the surrogate to every successful run so far; sample the posterior with emcee."""
+    import emcee
+    d = len(priors)
+    design_theta = np.array(runs.thetas)
+    z = observation.observable(np.array(runs.vectors))
     u_ok = np.column_stack([_cdf(p, design_theta[:, j]) for j, p in enumerate(priors)])
     surrogate = Surrogate(u_ok, z, settings.seed)
     y = observation.log_psd
@@ -417,16 +471,20 @@ def identify(model: ForwardModel, priors: Sequence[Prior], observed: Features,
     burn = int(max(settings.steps // 5, 2 * np.max(tau)))
     burn = min(burn, settings.steps - 10)
     thin = max(1, int(np.max(tau) / 2))
-    flat_u = chain_u[burn::thin].reshape(-1, d)
-    samples = np.column_stack([np.array(p.quantile(flat_u[:, j])) for j, p in enumerate(priors)])
-    chain = np.stack([np.array(p.quantile(chain_u[:, :, j].ravel())).reshape(chain_u.shape[:2])
-                      for j, p in enumerate(priors)], axis=-1)
-    result = Identification(tuple(priors), samples, chain, sampler.get_log_prob(),
-                            float(np.mean(sampler.acceptance_fraction)), np.asarray(tau),
-                            burn, thin, design_theta, z, observation, surrogate.cv_rmse,
-                            failed_design=failed, settings=settings)
-    result.check, result.median_z = _check_median(model, priors, observation, surrogate, samples)
-    return result
+    return _Fit(z, surrogate, sampler, chain_u, chain_u[burn::thin].reshape(-1, d),
+                np.asarray(tau), burn, thin)
+
+
+REFINE_MARGIN = 0.25
+"""The refined design's box: the posterior's 0.5-99.5 % range, widened by this share of it."""
+
+
+def _refined_design(flat_u: np.ndarray, n: int, seed: int) -> np.ndarray:
+    """Return ``n`` Sobol' points (probability scale) over the posterior samples' box."""
+    low, high = np.quantile(flat_u, [0.005, 0.995], axis=0)
+    pad = REFINE_MARGIN * (high - low)
+    low, high = np.clip(low - pad, 1e-6, 1 - 1e-6), np.clip(high + pad, 1e-6, 1 - 1e-6)
+    return low + (high - low) * unit_design(n, flat_u.shape[1], 'sobol', seed + 1)
 
 
 def _check_median(model: ForwardModel, priors: Sequence[Prior], observation: Observation,
