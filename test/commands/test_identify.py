@@ -111,7 +111,6 @@ def test_the_design_is_the_same_bits_on_one_or_two_workers():
 @pytest.mark.parametrize('sig, code, at', [
     (signal.SIGTERM, 143, 'design of'),         # setting up (the bag read, the model built)
     (signal.SIGINT, 130, 'design run 1/'),      # the design running on two workers
-    (signal.SIGTERM, 143, 'design run 12/12'),  # sampling the posterior
 ])
 def test_a_signal_stops_the_workers_and_writes_nothing(observed, tmp_path, sig, code, at):
     out = tmp_path / 'id'
