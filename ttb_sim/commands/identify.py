@@ -151,7 +151,8 @@ def _identify(path: Path, stage: Path, scenario: str | None, overrides: Sequence
     model, observed, record = _set_up(path, stage, scenario, overrides, keys, sensors,
                                       fmin, fmax, points, segment, priors)
     stop_if_asked()
-    n_design = settings.design or 8 * len(keys) + 8
+    from ttb_sim.twin.design import design_size
+    n_design = design_size(settings.design, len(keys))
     print(f'ttb-sim: identify: {len(keys)} parameter(s) from {len(model.sensors)} '
           f'sensor(s), {record:.3g} s recorded; design of {n_design} runs'
           + (f', then {settings.refine} over the first posterior' if settings.refine else ''),

@@ -59,8 +59,9 @@ import numpy as np
 
 from ttb_sim.config.sensor_records import SensorConfig
 from ttb_sim.errors import ScenarioError, SimulationError, TtbSimError
+from ttb_sim.twin.design import design_size, DesignRuns, refined_design
 from ttb_sim.twin.features import Features, FeatureSpec
-from ttb_sim.twin.forward import DesignRun, evaluate_many, ForwardModel, Runner
+from ttb_sim.twin.forward import ForwardModel, Runner
 from ttb_sim.twin.priors import Prior, unit_design
 
 __all__ = ['data_grid', 'Identification', 'identify', 'IdentifySettings', 'Observation',
@@ -365,16 +366,16 @@ def identify(model: ForwardModel, priors: Sequence[Prior], observed: Features,
             raise ScenarioError(f'--param {p.key}: identify takes uniform, normal or lognormal '
                                 'priors (a choice has no density to update)')
     observation = Observation.of(model, observed, record_s)
-    n_design = settings.design or 8 * d + 8
+    n_design = design_size(settings.design, d)
     u_design = unit_design(n_design, d, 'sobol', settings.seed)
-    runs = _DesignRuns(model, priors, runner, progress, n_design + settings.refine)
+    runs = DesignRuns(model, priors, runner, progress, n_design + settings.refine)
     runs.run(u_design)
     if len(runs.thetas) < d + 3:
         raise SimulationError(f'only {len(runs.thetas)} of {n_design} design runs succeeded (at '
                               f'least {d + 3} needed): {"; ".join(runs.failed[:3])}')
     fit = _sample(observation, priors, runs, settings)
     if settings.refine:   # a second design over the first posterior's box, then again
-        runs.run(_refined_design(fit.flat_u, settings.refine, settings.seed))
+        runs.run(refined_design(fit.flat_u, settings.refine, settings.seed))
         fit = _sample(observation, priors, runs, settings)
     samples = np.column_stack([np.array(p.quantile(fit.flat_u[:, j]))
                                for j, p in enumerate(priors)])
@@ -387,40 +388,6 @@ def identify(model: ForwardModel, priors: Sequence[Prior], observed: Features,
     result.check, result.median_z = _check_median(model, priors, observation, fit.surrogate,
                                                   samples)
     return result
-
-
-class _DesignRuns:
-    """The forward runs of the surrogate's designs, in design order, and their progress."""
-
-    def __init__(self, model: ForwardModel, priors: Sequence[Prior], runner: Runner | None,
-                 progress: Callable[[str], None] | None, total: int) -> None:
-        self.model, self.priors, self.runner, self.progress = model, priors, runner, progress
-        self.total = total
-        self.finished = 0
-        self.thetas: list[np.ndarray] = []
-        self.vectors: list[np.ndarray] = []
-        self.failed: list[str] = []
-
-    def run(self, u_design: np.ndarray) -> None:
-        """Run the design of ``u_design`` (probability scale); keep what succeeded."""
-        design = np.array([[p.quantile(np.array([x]))[0] for p, x in zip(self.priors, u)]
-                           for u in u_design])
-        records = evaluate_many(self.model, design, self.runner, self._report,
-                                first=len(self.thetas) + len(self.failed))
-        for theta, record in zip(design, records):   # design order, whatever finished first
-            if record['status'] == 'ok':
-                self.vectors.append(np.asarray(record['vector']))
-                self.thetas.append(theta)
-            else:   # a case refused or diverged (or its worker lost): the others go on
-                self.failed.append(f'{_shown(self.model.keys, theta)}: {record.get("error")}')
-
-    def _report(self, run: DesignRun, record: dict[str, Any]) -> None:
-        self.finished += 1
-        if self.progress is not None:
-            outcome = f'ok in {record.get("wall_time_s") or 0.0:.1f} s' \
-                if record['status'] == 'ok' else f'{record["status"]}: {record.get("error")}'
-            self.progress(f'design run {self.finished}/{self.total} ({run.name}) at '
-                          f'{_shown(self.model.keys, np.array(run.theta))}: {outcome}')
 
 
 @dataclass
@@ -437,7 +404,7 @@ class _Fit:
     thin: int
 
 
-def _sample(observation: Observation, priors: Sequence[Prior], runs: _DesignRuns,
+def _sample(observation: Observation, priors: Sequence[Prior], runs: DesignRuns,
             settings: IdentifySettings) -> _Fit:
     """Fit the surrogate to every successful run so far; sample the posterior with emcee."""
     import emcee
@@ -475,18 +442,6 @@ def _sample(observation: Observation, priors: Sequence[Prior], runs: _DesignRuns
                 np.asarray(tau), burn, thin)
 
 
-REFINE_MARGIN = 0.25
-"""The refined design's box: the posterior's 0.5-99.5 % range, widened by this share of it."""
-
-
-def _refined_design(flat_u: np.ndarray, n: int, seed: int) -> np.ndarray:
-    """Return ``n`` Sobol' points (probability scale) over the posterior samples' box."""
-    low, high = np.quantile(flat_u, [0.005, 0.995], axis=0)
-    pad = REFINE_MARGIN * (high - low)
-    low, high = np.clip(low - pad, 1e-6, 1 - 1e-6), np.clip(high + pad, 1e-6, 1 - 1e-6)
-    return low + (high - low) * unit_design(n, flat_u.shape[1], 'sobol', seed + 1)
-
-
 def _check_median(model: ForwardModel, priors: Sequence[Prior], observation: Observation,
                   surrogate: Surrogate, samples: np.ndarray
                   ) -> tuple[dict[str, Any], np.ndarray | None]:
@@ -501,7 +456,3 @@ def _check_median(model: ForwardModel, priors: Sequence[Prior], observation: Obs
     return {'theta': dict(model.values(median)),
             'rms_run_vs_data_log10': float(np.sqrt(np.mean((z - observation.log_psd) ** 2))),
             'rms_run_vs_surrogate_log10': float(np.sqrt(np.mean((z - predicted[0]) ** 2)))}, z
-
-
-def _shown(keys: Sequence[str], theta: np.ndarray) -> str:
-    return ', '.join(f'{k}={v:.6g}' for k, v in zip(keys, theta))
