@@ -66,7 +66,12 @@ def same_frames(a: list, b: list) -> None:
             np.testing.assert_array_equal(getattr(fa, field), getattr(fb, field), err_msg=field)
 
 
-@pytest.mark.parametrize('name', sorted(CASES))
+BIT_FOR_BIT = sorted(set(CASES) - {'live_coupled'})
+"""The built-ins whose realtime loop is qdldl's step in the same order of operations; the
+piled piers of live_coupled are condensed (test_condensed.py: equal to round-off)."""
+
+
+@pytest.mark.parametrize('name', BIT_FOR_BIT)
 def test_realtime_writes_the_frames_of_qdldl_bit_for_bit(name):
     sim, fast = run(name, 'realtime', CASES[name])
     assert sim.coupling.fused() and sim.compiled_loop, 'the compiled loop must be under test'

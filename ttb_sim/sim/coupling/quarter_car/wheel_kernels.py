@@ -49,13 +49,14 @@ import numpy as np
 
 from ttb_sim.fe.dense_kernels import solve_in_place
 from ttb_sim.sim.coupling.profile_kernels import quintic
+from ttb_sim.sim.integrators.interior_kernels import interior_finish, interior_load
 from ttb_sim.sim.integrators.newmark_kernels import (effective_load, finish_into, history,
                                                      largest_magnitude, solve_ldl)
 from ttb_sim.sim.kernel_registry import KernelTable
 
 HELPERS = ('quintic', '_centreline_profile', '_wheel_terms', '_green_correction',
            '_update_cars', 'history', 'effective_load', 'solve_ldl', 'finish_into',
-           'largest_magnitude', 'solve_in_place')
+           'largest_magnitude', 'solve_in_place', 'interior_load', 'interior_finish')
 """Functions the kernels call: :func:`ttb_sim.fe.compiled.jit` compiles them first."""
 
 
@@ -232,7 +233,7 @@ def _advance_quarter_cars(head: float, speed: float, dt: float, steps: int,
                           integrator: tuple[np.ndarray, ...], a0: float, a1: float,
                           green: np.ndarray, slot: np.ndarray, state: tuple[np.ndarray, ...],
                           wheels: tuple[np.ndarray, ...], work: tuple[np.ndarray, ...],
-                          gravity: float,
+                          interiors: tuple[np.ndarray, ...], gravity: float,
                           limit: float) -> tuple[float, int, float]:
     """
     Take up to ``steps`` coupled steps of girders and quarter cars, in place.
@@ -254,6 +255,11 @@ def _advance_quarter_cars(head: float, speed: float, dt: float, steps: int,
     state : (u, v, a, z, zv, za, contact) -- girder and sprung masses
     wheels : (positions, element, dofs, n0, w, p, b, e, hs_v, hs_a, r, r1, r2)
     work : (history [h_a | h_v], load, x0, solve work)
+    interiors : (start, boundary, rho, sigma, weight, p_hat, e_hat, d_m, d_c, eta, e, pre)
+        Substructure interiors condensed out of the girder system
+        (:meth:`~ttb_sim.sim.integrators.condensed.ModalInteriors.packed`, then their
+        modal state and work vector); start = [0]: none, the whole system is in the
+        integrator arrays.
 
     Returns
     -------
@@ -267,6 +273,8 @@ def _advance_quarter_cars(head: float, speed: float, dt: float, steps: int,
     u, v, a, z, zv, za, contact = state
     positions, element, dofs, n0, w, p, b, e, hs_v, hs_a, r, r1, r2 = wheels
     buffer, load, x0, scratch = work
+    (i_start, i_boundary, i_rho, i_sigma, i_weight, i_p, i_e_hat, i_dm, i_dc, i_eta, i_e,
+     i_pre) = interiors
     n = u.shape[0]
     h_a = buffer[:n]
     h_v = buffer[n:]
@@ -282,6 +290,8 @@ def _advance_quarter_cars(head: float, speed: float, dt: float, steps: int,
         history(u, v, a, a0, a1, h_v, h_a)
         load[:] = 0.0   # the coupling's other load is zero (as QuarterCarTrain.step)
         effective_load(indptr, indices, data, buffer, load, load)
+        interior_load(i_start, i_boundary, i_rho, i_sigma, i_weight, i_p, i_dm, i_dc, i_eta,
+                      i_e, i_pre, h_a, h_v, load)
         _wheel_terms(positions, speed, h, n_el, length, w_dofs, h_v, h_a, a0, a1,
                      has_profile, r, r1, r2, ms, mu, k, c, d, q, z, zv, za, gravity, element,
                      dofs, n0, w, p, b, e, hs_v, hs_a, load)
@@ -290,6 +300,7 @@ def _advance_quarter_cars(head: float, speed: float, dt: float, steps: int,
         solve_ldl(lp, li, lx, dinv, order, load, scratch, u)
         _update_cars(u, dofs, w, p, b, e, d, hs_v, hs_a, a0, a1, z, zv, za, contact)
         finish_into(u, a0, a1, h_v, h_a, v, a)
+        interior_finish(i_start, i_boundary, i_sigma, i_e_hat, i_eta, i_e, i_pre, u, v, a)
         peak = largest_magnitude(z, largest_magnitude(u, 0.0))
         if not peak <= limit:
             return head, step + 1, peak
