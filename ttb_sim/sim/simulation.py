@@ -40,8 +40,8 @@ from ttb_sim.sim.cost import CostEstimate, estimate_cost, STEP_BUDGET
 from ttb_sim.sim.coupling import FusedCoupling
 from ttb_sim.sim.frames import Frame, Layout
 from ttb_sim.sim.integrators.newmark import Newmark
-from ttb_sim.sim.substructure.piled_piers import (InterfaceCheck, pile_coordinates, pile_outputs,
-                                                  PiledFoundations, PileGauges,
+from ttb_sim.sim.substructure.piled_piers import (InterfaceCheck, pile_coordinates,
+                                                  PiledFoundations, PileGauges, PileOutputs,
                                                   RigidDisplacement)
 from ttb_sim.sim.variants import blas_threads, resolve_threads, solver_variant
 
@@ -157,6 +157,7 @@ class Simulation:
         self.gauges = PileGauges.of(st, [(g.pier, g.pile, g.depth)
                                          for g in gauge_requests(scenario.all_sensors)])
         """The pile strain gauges the sensors read (through the reduction basis)."""
+        self.pile_outputs = PileOutputs(st, self.foundations, self.gauges)
         self.layout = Layout(n_spans=scenario.bridge.n_spans, n_supports=st.n_supports,
                              n_bodies=self.coupling.n_bodies, n_axles=self.coupling.n_axles,
                              observers=names,
@@ -377,7 +378,7 @@ class Simulation:
             outside = st.pier_top_dofs == st.n_free
             pier_tops = np.where(outside, tops[0][moving, :3], pier_tops)
             pier_acc = np.where(outside, tops[2][moving, :3], pier_acc)
-        piles = pile_outputs(st, self.foundations, ue, ve, ae, self.gauges)
+        piles = self.pile_outputs(ue, ve, ae)
         if piles:
             self.rigid.update(ue[st.midspan_dofs], piles['pile_displacement'])
             self.interface.update(pile_coordinates(st, self.foundations, ue))

@@ -106,11 +106,12 @@ class InteriorModes:
         D M_ib and D C_ib (the boundary load's part in the boundary's own history).
     schur : float (nb, nb)
         -S_bi S_ii^-1 S_ib, added to the kept system's effective matrix.
-    w_x, w_v, w_a : complex (n, m)
+    w_state : complex (3 n, m)
         The interior displacement, velocity and acceleration of each mode's amplitude
-        (rows of W, and of W diag(lambda) for the acceleration; weights applied).
-    input_acceleration : float (3, n, nb)
-        M_ii^-1 M_ib, M_ii^-1 C_ib, M_ii^-1 K_ib: the acceleration's direct part.
+        (rows of W, and of W diag(lambda) for the acceleration; weights applied),
+        stacked for one product a frame.
+    input_acceleration : float (n, 3 nb)
+        [M_ii^-1 M_ib, M_ii^-1 C_ib, M_ii^-1 K_ib]: the acceleration's direct part.
     w_inv : complex (m, 2n)
         Rows of W^-1: the modal amplitudes of a state [x; x'].
     condition : float
@@ -128,11 +129,9 @@ class InteriorModes:
     d_m: np.ndarray
     d_c: np.ndarray
     schur: np.ndarray
-    w_x: np.ndarray
-    w_v: np.ndarray
+    w_state: np.ndarray
     w_inv: np.ndarray
     condition: float
-    w_a: np.ndarray
     input_acceleration: np.ndarray
 
     def amplitudes(self, u: np.ndarray, v: np.ndarray) -> np.ndarray:
@@ -153,9 +152,10 @@ class InteriorModes:
         x'' = Re(W_a eta) - M_ii^-1 g with g from the boundary's state in u, v, a
         (free DOFs): the equation of motion, which Newmark's step satisfies.
         """
-        b = self.boundary
-        direct = np.einsum('qij,qj->i', self.input_acceleration, np.stack([a[b], v[b], u[b]]))
-        return ((self.w_x @ eta).real, (self.w_v @ eta).real, (self.w_a @ eta).real - direct)
+        b, n = self.boundary, self.interior.size
+        xva = (self.w_state @ eta).real
+        xva[2 * n:] -= self.input_acceleration @ np.concatenate([a[b], v[b], u[b]])
+        return xva[:n], xva[n:2 * n], xva[2 * n:]
 
 
 def _dense(matrix: sp.csr_matrix, rows: np.ndarray, cols: np.ndarray) -> np.ndarray:
@@ -197,10 +197,10 @@ def interior_modes(mass: sp.csr_matrix, damping: sp.csr_matrix, stiffness: sp.cs
         p_hat=np.ascontiguousarray(p_full[:, keep].T),
         e_hat=np.ascontiguousarray(np.stack([e_kept @ coupling[q] for q in range(3)], axis=1)),
         d_m=d @ coupling[0], d_c=d @ coupling[1], schur=0.5 * (schur + schur.T),
-        w_x=w[:n, keep] * weight, w_v=w[n:, keep] * weight,
+        w_state=np.vstack([w[:n, keep] * weight, w[n:, keep] * weight,
+                           w[n:, keep] * (weight * lam[keep])]),
         w_inv=np.ascontiguousarray(w_inv[keep]), condition=condition,
-        w_a=w[n:, keep] * (weight * lam[keep]),
-        input_acceleration=np.stack([m_inv @ coupling[q] for q in range(3)]))
+        input_acceleration=np.hstack([m_inv @ coupling[q] for q in range(3)]))
 
 
 def _modes(m_ii: np.ndarray, c_ii: np.ndarray, k_ii: np.ndarray

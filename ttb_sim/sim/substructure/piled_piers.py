@@ -313,45 +313,67 @@ class PileGauges:
         return cls(len(requests), rows)
 
 
-def pile_outputs(structure: Structure, foundations: PiledFoundations, ue: np.ndarray,
-                 ve: np.ndarray, ae: np.ndarray,
-                 gauges: PileGauges | None = None) -> dict[str, np.ndarray]:
+class PileOutputs:
     """
-    Return the pile and soil fields of a :class:`~ttb_sim.sim.frames.Frame` (none unpiled).
+    The pile and soil fields of a :class:`~ttb_sim.sim.frames.Frame` (none unpiled).
 
     Monolithic piers read their coordinates from the structure state (extended
     free ue, ve, ae); partitioned ones from ``foundations`` at the current time.
     Soil points are placed in track axes: x from the pier's support, z from the
     ground surface ``depth`` below the bearings. ``gauges`` adds ``pile_strain``.
+    Each pier's output rows (pile heads, pile rotations, soil points) are stacked
+    once into one matrix, so a frame costs one product per pier with its [q, q'', q'].
     """
-    if not structure.piled:
-        return {}
-    states = iter(foundations.current())
-    disp, acc, rot, soil = [], [], [], []
-    strain = np.zeros((gauges.count if gauges is not None else 0, 3))
-    for k, pier in enumerate(structure.piled):
-        op = pier.operator
-        if pier.block is not None:
-            q, qv, qa = ue[pier.block], ve[pier.block], ae[pier.block]
-        else:
-            state = next(states)
-            q, qv, qa = state.u, state.v, state.a
-        states_q = np.column_stack([q, qa, qv])   # one product per operator, not three
-        heads = op.pile_heads @ states_q[:, :2]
-        disp.append(heads[:, 0].reshape(-1, 3))
-        acc.append(heads[:, 1].reshape(-1, 3))
-        rot.append((op.pile_rotations @ qv).reshape(-1, 3) if op.pile_rotations is not None
-                   else np.zeros((op.n_piles, 3)))
-        origin = np.array([pier.support * structure.girder.span_length, 0.0, -op.depth])
-        points = (op.soil_points @ states_q).reshape(-1, 3, 3)   # (point, axis, u|a|v)
-        soil.append(np.hstack([op.soil_point_positions + origin,
-                               *points.transpose(2, 0, 1)]))
-        if gauges is not None and k in gauges.rows:
-            places, rows = gauges.rows[k]
-            strain[places, 0] = rows @ q
-    return {'pile_displacement': np.vstack(disp), 'pile_acceleration': np.vstack(acc),
-            'pile_rotation_rate': np.vstack(rot), 'soil_points': np.vstack(soil),
-            'pile_strain': strain}
+
+    def __init__(self, structure: Structure, foundations: PiledFoundations,
+                 gauges: PileGauges | None = None) -> None:
+        self.structure = structure
+        self.foundations = foundations
+        self.gauges = gauges
+        self._rows = []
+        self._positions = []
+        for pier in structure.piled:
+            op = pier.operator
+            rotations = (op.pile_rotations if op.pile_rotations is not None
+                         else np.zeros((3 * op.n_piles, op.size)))
+            self._rows.append(np.vstack([op.pile_heads, rotations, op.soil_points]))
+            origin = np.array([pier.support * structure.girder.span_length, 0.0, -op.depth])
+            self._positions.append(op.soil_point_positions + origin)
+        self._piles = sum(p.operator.n_piles for p in structure.piled)
+        self._points = sum(len(p.operator.soil_point_names) for p in structure.piled)
+
+    def __call__(self, ue: np.ndarray, ve: np.ndarray, ae: np.ndarray) -> dict[str, np.ndarray]:
+        """Return the fields of one frame (new arrays, the frame's own)."""
+        structure, gauges = self.structure, self.gauges
+        if not structure.piled:
+            return {}
+        states = iter(self.foundations.current())
+        disp, acc, rot = (np.empty((self._piles, 3)) for _ in range(3))
+        soil = np.empty((self._points, 12))
+        strain = np.zeros((gauges.count if gauges is not None else 0, 3))
+        piles = points = 0
+        for k, pier in enumerate(structure.piled):
+            if pier.block is not None:
+                q, qv, qa = ue[pier.block], ve[pier.block], ae[pier.block]
+            else:
+                state = next(states)
+                q, qv, qa = state.u, state.v, state.a
+            out = self._rows[k] @ np.column_stack([q, qa, qv])   # (rows, u|a|v)
+            n_p, n_s = pier.operator.n_piles, self._positions[k].shape[0]
+            disp[piles:piles + n_p] = out[:3 * n_p, 0].reshape(-1, 3)
+            acc[piles:piles + n_p] = out[:3 * n_p, 1].reshape(-1, 3)
+            rot[piles:piles + n_p] = out[3 * n_p:6 * n_p, 2].reshape(-1, 3)
+            soil[points:points + n_s, :3] = self._positions[k]
+            # rows (point, axis), columns u|a|v -> per point [u xyz, a xyz, v xyz]
+            soil[points:points + n_s, 3:] = (
+                out[6 * n_p:].reshape(n_s, 3, 3).transpose(0, 2, 1).reshape(n_s, 9))
+            piles += n_p
+            points += n_s
+            if gauges is not None and k in gauges.rows:
+                places, rows = gauges.rows[k]
+                strain[places, 0] = rows @ q
+        return {'pile_displacement': disp, 'pile_acceleration': acc,
+                'pile_rotation_rate': rot, 'soil_points': soil, 'pile_strain': strain}
 
 
 class RigidDisplacement:
@@ -373,6 +395,13 @@ class RigidDisplacement:
         counts = [p.operator.n_piles for p in structure.piled]
         rows = np.split(np.arange(sum(counts)), np.cumsum(counts)[:-1])
         self._slices = dict(zip(piled, rows))
+        # the mean settlement of each support's piles as one product: (supports + 1, piles)
+        self._mean = np.zeros((self.n_spans + 1, sum(counts)))
+        for support, pile_rows in self._slices.items():
+            if pile_rows.size:
+                self._mean[support, pile_rows] = 1.0 / pile_rows.size
+        spans = np.asarray(self.spans, dtype=np.intp)
+        self._ends = (spans, spans + 1)
         n = len(self.spans)
         self._peak = np.zeros((2, n))
         self._sq = np.zeros((3, n))
@@ -382,12 +411,10 @@ class RigidDisplacement:
         """Take one frame: mid-span (n_spans, 3) and pile heads (n_piles, 3) displacements."""
         if not self.spans or pile_displacement.size == 0:
             return
-        settle = np.zeros(self.n_spans + 1)
-        for support, rows in self._slices.items():
-            settle[support] = pile_displacement[rows, 2].mean()
-        spans = np.asarray(self.spans)
-        estimate = 0.5 * (settle[spans] + settle[spans + 1])
-        computed = midspan[spans, 2]
+        settle = self._mean @ pile_displacement[:, 2]
+        left, right = self._ends
+        estimate = 0.5 * (settle[left] + settle[right])
+        computed = midspan[left, 2]
         self._peak[0] = np.maximum(self._peak[0], np.abs(estimate))
         self._peak[1] = np.maximum(self._peak[1], np.abs(computed))
         self._sq += np.stack([estimate, computed, computed - estimate]) ** 2
