@@ -267,6 +267,29 @@ def test_window_margin_key_sets_the_window():
         list(sim.frames())
         window = sim.coupling.window
         rear = sim.scenario.train.start_position + float(np.min(sim.coupling.contact_x))
-        assert window.start <= rear - margin < window.start + 6.0   # widened to a joint
+        track_start = float(track_free_dofs(sim.structure)[1].min())
+        wanted = max(rear - margin, track_start)
+        assert window.start <= wanted < window.start + 6.0   # widened to a joint
         sizes.append(window.size)
     assert sizes[0] < sizes[1]
+
+
+def test_a_window_reaching_past_the_first_joint_takes_the_whole_end_unit(small):
+    # An end unit cut inside the window would be condensed in part onto kept DOFs of its
+    # own: a stiff link the multi-rate exchange does not survive (paper_ttbi, margin 60 m:
+    # gain 0.037, the contact iteration diverged 0.11 s after the window moved there).
+    from ttb_sim.sim.integrators.multirate import coupling_gain, MAX_COUPLING_GAIN
+    st, _ = small
+    static = static_track_basis(st, 'qdldl')
+    track_x = track_free_dofs(st)[1]
+    first, last = float(static.joints[0]), float(static.joints[-1])
+    assert track_x.min() < first - 1.0 and last + 1.0 < track_x.max()
+    window = track_window(st, static, rigid_track_basis(st), first - 1.0, last + 1.0)
+    assert window.start == track_x.min() and window.end == track_x.max()
+    fast = np.unique(window.full_to_reduced[reduced_track.rail_and_slab_dofs(st)])
+    fast = fast[fast < window.size]
+    slow = np.setdiff1d(np.arange(window.size), fast)
+    gain = coupling_gain(project(st.mass, window.local_basis),
+                         project(st.damping, window.local_basis),
+                         project(st.stiffness, window.basis), fast, slow, 1e-4, 5)
+    assert gain <= MAX_COUPLING_GAIN
