@@ -293,3 +293,15 @@ def test_a_window_reaching_past_the_first_joint_takes_the_whole_end_unit(small):
                          project(st.damping, window.local_basis),
                          project(st.stiffness, window.basis), fast, slow, 1e-4, 5)
     assert gain <= MAX_COUPLING_GAIN
+
+
+def test_a_window_at_the_track_end_stays_there():
+    # Once the window takes the track to its last node it cannot move further: it must not
+    # be rebuilt at every step while the train runs on towards the end.
+    sim = Simulation(load_scenario('moving_force_beam', values=SMALL + [
+        ('solver.variant', 'reduced'), ('solver.duration', 0.01),
+        ('train.start_position', 120.0)]))   # front + margin beyond the track's end (142 m)
+    list(sim.frames())
+    window = sim.coupling.window
+    assert window.reaches_end
+    assert sim.coupling.window_moves == 1

@@ -130,6 +130,9 @@ class TrackWindow:
     full_to_reduced : numpy.ndarray
         (n_full,) reduced index of each full DOF; ``n_reduced`` (the ground
         slot) where the DOF is not a reduced one.
+    reaches_start, reaches_end : bool
+        The window takes the track to its first (last) node: it cannot move
+        further that way.
 
     """
 
@@ -140,6 +143,8 @@ class TrackWindow:
     kept: np.ndarray
     free_to_reduced: np.ndarray
     full_to_reduced: np.ndarray
+    reaches_start: bool = False
+    reaches_end: bool = False
 
     @property
     def size(self) -> int:
@@ -350,7 +355,8 @@ def track_window(structure: Structure, static: StaticTrackBasis, rigid: sp.csr_m
                              shape=(n_free, n_red))
 
     return TrackWindow(start, end, basis(static.basis), basis(rigid), kept, free_to_red,
-                       free_to_red[structure.full_to_free])
+                       free_to_red[structure.full_to_free], reaches_start=not before.size,
+                       reaches_end=not after.size)
 
 
 def project(matrix: sp.spmatrix, basis: sp.csr_matrix) -> sp.csr_matrix:
@@ -483,7 +489,9 @@ class ReducedTrainTrackCoupling(TrainTrackCoupling):
         """Move the window when the train nears its end, then take the coupled step."""
         assert self.window is not None, 'start() first'
         rear, front = self._axle_span(head)
-        due = front + self.margin > self.window.end or rear < self.window.start
+        window = self.window
+        due = ((front + self.margin > window.end and not window.reaches_end)
+               or (rear < window.start and not window.reaches_start))
         if due and self.nm.at_slow_step:
             self._move_window(head)
         super().step(head, speed)
