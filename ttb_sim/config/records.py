@@ -170,15 +170,19 @@ class SolverConfig:
                          'two when the 1-minute load average leaves at least 1.5 cores free, '
                          'else one (two threads on a busy machine wait for each other). The '
                          'results are the same bits with any count.', low=0, high=64)
-    rail_steps: int = param(5, '-', "solver.variant 'realtime' with multibody cars: rail "
-                            'steps (dt) per step of the structure under the rails (slabs, '
-                            'base plates, girders, piers), which advances at rail_steps * dt '
-                            '(docs/performance.md); 1 = both at dt, still staggered.', low=1,
+    rail_steps: int = param(2, '-', "solver.variant 'realtime' with multibody cars: rail "
+                            'steps (dt) per step of the structure under the slabs (base '
+                            'plates, girders, bearings, piers), which advances at rail_steps * '
+                            'dt '
+                            '(docs/performance.md: 5 moves the dynamic wheel-rail force by '
+                            '1.3 %, 2 by 0.2 %); 1 = both at dt, still staggered.', low=1,
                             high=50)
-    window_margin: float = param(30.0, 'm', "solver.variant 'reduced': detailed track kept "
-                                 'behind the last axle and ahead of the first; more keeps '
-                                 "more of the track's waves at more cost "
-                                 '(docs/performance.md).', low=5.0, high=10000.0)
+    window_margin: float = param(100.0, 'm', "solver.variant 'reduced' and 'realtime' "
+                                 '(multibody cars): detailed track kept behind the last axle '
+                                 "and ahead of the first; more keeps more of the track's waves "
+                                 'at more cost (docs/performance.md: 30 m misses the bearing '
+                                 'forces by 1.4-1.7 %, 100 m by 0.5-0.75 %).', low=5.0,
+                                 high=10000.0)
 
 
 @dataclass(frozen=True)
