@@ -113,7 +113,7 @@ class InteriorModes:
     w_inv : complex (m, 2n)
         Rows of W^-1: the modal amplitudes of a state [x; x'].
     condition : float
-        Condition number of W.
+        Condition number (1-norm) of W in the scaled coordinates it was found in.
 
     """
 

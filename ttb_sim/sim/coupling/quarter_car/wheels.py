@@ -47,8 +47,7 @@ from ttb_sim.model.structure import Structure
 from ttb_sim.model.vehicle.train import QuarterCars
 from ttb_sim.sim.coupling.base import FreeDofState, girder_wheel_load, VehicleOutputs
 from ttb_sim.sim.coupling.quarter_car import wheel_kernels
-from ttb_sim.sim.integrators.condensed import condense_interiors, ModalInteriors
-from ttb_sim.sim.integrators.newmark import Newmark
+from ttb_sim.sim.coupling.quarter_car.condensed_girders import CondensedGirders, NO_INTERIORS
 from ttb_sim.sim.integrators.protocol import Integrator
 
 DENSE_GIRDER_LIMIT = 3000
@@ -316,7 +315,7 @@ class QuarterCarTrain(FreeDofState):
         self._arguments: tuple[tuple[Any, ...], tuple[Any, ...]] | tuple[()] = ()
         self._held: tuple[np.ndarray, ...] = ()
         """The state vectors the loop's arguments were made for (a new one: made again)."""
-        self._condensed: _CondensedGirders | None = None
+        self._condensed: CondensedGirders | None = None
         """The compiled loop's system with the piled piers' interiors condensed, or None."""
 
     def _profile(self, positions: np.ndarray
@@ -351,7 +350,7 @@ class QuarterCarTrain(FreeDofState):
         if self._fused is None:
             kernel = wheel_kernels.KERNELS.compiled('advance_quarter_cars')
             ok = kernel is not None and self.kernel.compiled
-            self._condensed = _CondensedGirders.of(self) if ok else None
+            self._condensed = CondensedGirders.of(self) if ok else None
             nm = self._condensed.nm if self._condensed is not None else self.nm
             arrays = nm.fused_arrays()
             self._fused = (kernel, arrays) if ok and arrays is not None else ()
@@ -388,7 +387,7 @@ class QuarterCarTrain(FreeDofState):
         condensed = self._condensed
         w_dofs, green, slot, nm = girder.w_dofs, k._green, k._slot, self.nm
         state: tuple[np.ndarray, ...] = (self.u, self.v, self.a)
-        interiors = _NO_INTERIORS
+        interiors = NO_INTERIORS
         if condensed is not None:
             state = condensed.start(state)
             w_dofs, green, slot = condensed.w_dofs, condensed.green, condensed.slot
@@ -441,78 +440,3 @@ class QuarterCarTrain(FreeDofState):
         wheel_rail = np.zeros((n_b, n_a, 2, 3))
         wheel_rail[:, :, :, 2] = 0.5 * self.kernel.contact.reshape(n_b, n_a)[:, :, None]
         return VehicleOutputs(acc, np.zeros((n_b, 3)), wheel_rail)
-
-
-_NO_INTERIORS = (np.zeros(1, dtype=np.int64), np.zeros((0, 0), dtype=np.int64),
-                 *(np.zeros(0, complex) for _ in range(2)), np.zeros(0),
-                 np.zeros((0, 0), complex), np.zeros((0, 3, 0), complex),
-                 np.zeros((0, 0, 0)), np.zeros((0, 0, 0)),
-                 *(np.zeros(0, complex) for _ in range(3)))
-"""The compiled loop's interiors when none is condensed (start = [0])."""
-
-
-class _CondensedGirders:
-    """
-    The compiled loop's system with the monolithic piled piers' interiors condensed.
-
-    :mod:`~ttb_sim.sim.integrators.condensed` takes each reduced substructure's
-    coordinates but its pier top out of the girder system and steps them mode by
-    mode inside the loop; this holds the kept system's integrator, its Green's
-    function on the girder, the loop's state on the kept DOFs and the interiors'
-    modal state, and writes the whole state back after each call of the loop.
-    """
-
-    def __init__(self, interiors: ModalInteriors, nm: Newmark, train: QuarterCarTrain) -> None:
-        self.interiors = interiors
-        self.nm: Integrator = nm
-        self.size = interiors.keep.size
-        girder, n_free = train.structure.girder, train.structure.n_free
-        self.w_dofs = np.where(girder.w_dofs >= n_free, self.size, girder.w_dofs)
-        dofs = np.unique(self.w_dofs)
-        dofs = dofs[dofs < self.size]
-        unit = np.zeros((self.size, dofs.size))
-        unit[dofs, np.arange(dofs.size)] = 1.0
-        self.green = np.zeros((dofs.size + 1, dofs.size + 1))
-        self.green[:-1, :-1] = np.asarray(nm.solve(unit))[dofs]
-        self.slot = np.full(self.size + 1, dofs.size, dtype=np.intp)
-        self.slot[dofs] = np.arange(dofs.size)
-        self.kept = tuple(np.zeros(self.size) for _ in range(3))
-        modes = sum(m.rho.size for m in interiors.modes)
-        self._modal = tuple(np.zeros(modes, complex) for _ in range(3))
-        self.arguments = (*interiors.packed(), *self._modal)
-
-    @classmethod
-    def of(cls, train: QuarterCarTrain) -> _CondensedGirders | None:
-        """Return the condensed system of a train's structure, or None (nothing to condense)."""
-        st, nm = train.structure, train.nm
-        blocks = [p.block for p in st.piled if p.block is not None]
-        if not blocks or not hasattr(nm, 'dt'):
-            return None
-        interiors = condense_interiors(st.mass, st.damping, st.stiffness, blocks,
-                                       float(getattr(nm, 'dt')))
-        if interiors is None:
-            return None
-        index = interiors.kept_index
-        girder = st.girder.w_dofs[st.girder.w_dofs < st.n_free]
-        if not np.array_equal(index[girder], girder):   # the loop's wheels index the girders
-            return None
-        mass, damping, stiffness = interiors.kept_matrices(st.mass, st.damping, st.stiffness)
-        kept = Newmark(mass, damping, stiffness, float(getattr(nm, 'dt')),
-                       method=str(getattr(nm, 'method', 'qdldl')), lean=True, fused=True)
-        if kept.fused_arrays() is None:
-            return None
-        return cls(interiors, kept, train)
-
-    def start(self, state: tuple[np.ndarray, ...]) -> tuple[np.ndarray, ...]:
-        """Take the whole state (a start, or a state set from outside); return the kept one."""
-        keep = self.interiors.keep
-        for out, values in zip(self.kept, state):
-            out[:] = values[keep]
-        eta, e = self.interiors.amplitudes(*state)
-        self._modal[0][:] = eta
-        self._modal[1][:] = e
-        return self.kept
-
-    def expand(self, state: tuple[np.ndarray, ...]) -> None:
-        """Write the kept state and the interiors' coordinates into the whole ``state``."""
-        self.interiors.expand(self.kept, self._modal[0], state)
