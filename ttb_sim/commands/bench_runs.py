@@ -71,7 +71,8 @@ def _dof_counts(sim: Any) -> dict[str, int]:
     DOF counts per subsystem: track, bridge (girders, bearings, piers), vehicle.
 
     ``solved`` counts the track-bridge DOFs the time step solves (fewer than
-    ``structure`` with the reduced track) plus the vehicle's.
+    ``structure`` with the reduced track, or with the piled piers' interiors condensed,
+    which the step advances mode by mode) plus the vehicle's.
     """
     st = sim.structure
     track = 0
@@ -80,7 +81,8 @@ def _dof_counts(sim: Any) -> dict[str, int]:
         full = np.unique(np.concatenate([line.dofs.ravel() for line in lines]))
         track = int(np.count_nonzero(st.full_to_free[full] < st.n_free))
     vehicle = sum(int(np.size(x)) for x in sim.coupling.monitored()[1:])
-    solved = int(getattr(sim.coupling, 'n_free', st.n_free))
+    # the reduced track's window, or the girder system left by condensed pier interiors
+    solved = int(getattr(sim.coupling, 'solved_dofs', getattr(sim.coupling, 'n_free', st.n_free)))
     # piled piers: their reduced coordinates (inside the structure when monolithic) and the
     # full FE DOFs they were reduced from
     inside = sum(p.operator.size for p in st.piled if p.block is not None)

@@ -345,6 +345,11 @@ class QuarterCarTrain(FreeDofState):
         self.u, self.v, self.a = self.kernel.step(self.u, self.v, self.a, self._zero,
                                                   positions, speed, self._profile(positions))
 
+    @property
+    def solved_dofs(self) -> int:
+        """The girder-system DOFs a step solves: fewer with the piers' interiors condensed."""
+        return self._condensed.size if self._condensed is not None else self.structure.n_free
+
     def fused(self) -> bool:
         """Tell whether :meth:`advance` runs the compiled loop (else it steps one by one)."""
         if self._fused is None:
