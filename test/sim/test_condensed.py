@@ -65,7 +65,7 @@ def step_both(mass, damping, stiffness, blocks, dt, loads):
     ci = condense_interiors(mass, damping, stiffness, blocks, dt)
     assert ci is not None
     kept = Newmark(*ci.kept_matrices(mass, damping, stiffness), dt, method='qdldl', lean=True)
-    start, boundary, rho, sigma, weight, p_hat, e_hat, d_m, d_c = ci.packed()
+    start, boundary, rho, sigma, p_hat, e_hat, d_m, d_c = ci.packed()
     u, v, a = np.zeros(n), np.zeros(n), np.zeros(n)
     eta, e = ci.amplitudes(u, v, a)
     pre = np.zeros_like(eta)
@@ -76,7 +76,7 @@ def step_both(mass, damping, stiffness, blocks, dt, loads):
         v, a = (np.array(x) for x in whole.finish(u, h_v, h_a))
         h_v, h_a = kept.history(uk, vk, ak)
         rhs = kept.effective_load(f[ci.keep], h_v, h_a)
-        interior_kernels.interior_load(start, boundary, rho, sigma, weight, p_hat, d_m, d_c,
+        interior_kernels.interior_load(start, boundary, rho, sigma, p_hat, d_m, d_c,
                                        eta, e, pre, h_a, h_v, rhs)
         uk = np.array(kept.solve(rhs))
         vk, ak = (np.array(x) for x in kept.finish(uk, h_v, h_a))
@@ -112,7 +112,7 @@ def test_the_schur_complement_is_the_modal_forms_feedthrough():
     a0, a1 = 4.0 / dt**2, 2.0 / dt
     s = (k + a1 * c + a0 * m).toarray()
     s_ib = s[np.ix_(interior, boundary)]
-    from_modes = np.einsum('k,kj,kl->jl', modes.weight, modes.p_hat,
+    from_modes = np.einsum('kj,kl->jl', modes.p_hat,   # p_hat carries the pairs' weight 2
                            modes.sigma[:, None] * np.einsum('kqj,q->kj', modes.e_hat,
                                                             np.array([a0, a1, 1.0])))
     mass_part = (m.toarray()[np.ix_(boundary, interior)]

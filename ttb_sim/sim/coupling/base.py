@@ -149,3 +149,22 @@ def girder_wheel_load(girder: GirderLine, n_full: int, positions: np.ndarray,
     element, (n0,) = girder.rows(positions)
     return np.bincount(girder.w_dofs_full[element].ravel(),
                        weights=(-forces[:, None] * n0).ravel(), minlength=n_full)
+
+
+def girder_green(integrator: Integrator, n_free: int,
+                 girder_dofs: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """
+    Return the inverse effective matrix among the girder DOFs, and each DOF's slot in it.
+
+    ``integrator.solve`` of a unit load on each of ``girder_dofs`` (free DOFs of a
+    system of ``n_free``). The block gets one more row and column of zeros, the
+    slot of the constrained DOFs (index ``n_free`` in ``w_dofs``).
+    """
+    k = girder_dofs.size
+    unit = np.zeros((n_free, k))
+    unit[girder_dofs, np.arange(k)] = 1.0
+    green = np.zeros((k + 1, k + 1))
+    green[:k, :k] = np.asarray(integrator.solve(unit))[girder_dofs]
+    slot = np.full(n_free + 1, k, dtype=np.intp)
+    slot[girder_dofs] = np.arange(k)
+    return green, slot

@@ -93,10 +93,9 @@ class InteriorModes:
         Free-DOF indices of the interior and of the boundary it meets.
     rho, sigma : complex (m,)
         The trapezoidal step of each mode.
-    weight : float (m,)
-        2 for a mode standing for a conjugate pair, 1 for a real one.
     p_hat : complex (m, nb)
-        P W: the boundary force of each mode's amplitude.
+        P W: the boundary force of each mode's amplitude (times 2 for a mode that
+        stands for a conjugate pair, as every row below).
     e_hat : complex (m, 3, nb)
         W^-1 E applied to M_ib, C_ib, K_ib: each mode's input from the boundary's
         acceleration, velocity and displacement.
@@ -121,7 +120,6 @@ class InteriorModes:
     boundary: np.ndarray
     rho: np.ndarray
     sigma: np.ndarray
-    weight: np.ndarray
     p_hat: np.ndarray
     e_hat: np.ndarray
     d_m: np.ndarray
@@ -191,8 +189,8 @@ def interior_modes(mass: sp.csr_matrix, damping: sp.csr_matrix, stiffness: sp.cs
     weight = np.where(real[keep], 1.0, 2.0)
     e_kept = e_full[keep]
     return InteriorModes(
-        interior=i, boundary=b, rho=rho[keep], sigma=sigma[keep], weight=weight,
-        p_hat=np.ascontiguousarray(p_full[:, keep].T),
+        interior=i, boundary=b, rho=rho[keep], sigma=sigma[keep],
+        p_hat=np.ascontiguousarray((p_full[:, keep] * weight).T),
         e_hat=np.ascontiguousarray(np.stack([e_kept @ coupling[q] for q in range(3)], axis=1)),
         d_m=d @ coupling[0], d_c=d @ coupling[1], schur=0.5 * (schur + schur.T),
         w_state=np.vstack([w[:n, keep] * weight, w[n:, keep] * weight,
@@ -283,7 +281,7 @@ class ModalInteriors:
         """
         Return the arrays the kernels read, every interior's modes end to end.
 
-        (start (P + 1,), boundary (P, nb) kept indices, rho, sigma, weight, p_hat,
+        (start (P + 1,), boundary (P, nb) kept indices, rho, sigma, p_hat,
         e_hat, d_m (P, nb, nb), d_c).
         """
         index = self.kept_index
@@ -299,7 +297,7 @@ class ModalInteriors:
                     else np.zeros(shape, dtype=dtype))
 
         return (start, boundary, cat('rho', (0,), complex), cat('sigma', (0,), complex),
-                cat('weight', (0,), float), cat('p_hat', (0, nb), complex),
+                cat('p_hat', (0, nb), complex),
                 cat('e_hat', (0, 3, nb), complex),
                 np.array([m.d_m for m in self.modes]).reshape(len(self.modes), nb, nb),
                 np.array([m.d_c for m in self.modes]).reshape(len(self.modes), nb, nb))

@@ -31,7 +31,7 @@ from ttb_sim.sim.kernel_registry import KernelTable
 
 
 def interior_load(start: np.ndarray, boundary: np.ndarray, rho: np.ndarray,
-                  sigma: np.ndarray, weight: np.ndarray, p_hat: np.ndarray,
+                  sigma: np.ndarray, p_hat: np.ndarray,
                   d_m: np.ndarray, d_c: np.ndarray, eta: np.ndarray, e: np.ndarray,
                   pre: np.ndarray, h_a: np.ndarray, h_v: np.ndarray,
                   load: np.ndarray) -> None:
@@ -48,8 +48,7 @@ def interior_load(start: np.ndarray, boundary: np.ndarray, rho: np.ndarray,
         for j in range(nb):
             acc = 0.0
             for k in range(start[p], start[p + 1]):
-                q = p_hat[k, j] * pre[k]
-                acc += weight[k] * q.real
+                acc += (p_hat[k, j] * pre[k]).real
             for m in range(nb):
                 dof = boundary[p, m]
                 acc += d_m[p, j, m] * h_a[dof] + d_c[p, j, m] * h_v[dof]

@@ -28,6 +28,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from ttb_sim.sim.coupling.base import girder_green
 from ttb_sim.sim.integrators.condensed import condense_interiors, ModalInteriors
 from ttb_sim.sim.integrators.newmark import Newmark
 from ttb_sim.sim.integrators.protocol import Integrator
@@ -37,8 +38,8 @@ if TYPE_CHECKING:
 
 
 NO_INTERIORS = (np.zeros(1, dtype=np.int64), np.zeros((0, 0), dtype=np.int64),
-                *(np.zeros(0, complex) for _ in range(2)), np.zeros(0),
-                np.zeros((0, 0), complex), np.zeros((0, 3, 0), complex),
+                *(np.zeros(0, complex) for _ in range(2)), np.zeros((0, 0), complex),
+                np.zeros((0, 3, 0), complex),
                 np.zeros((0, 0, 0)), np.zeros((0, 0, 0)),
                 *(np.zeros(0, complex) for _ in range(3)))
 """The compiled loop's interiors when none is condensed (start = [0])."""
@@ -62,13 +63,7 @@ class CondensedGirders:
         girder, n_free = train.structure.girder, train.structure.n_free
         self.w_dofs = np.where(girder.w_dofs >= n_free, self.size, girder.w_dofs)
         dofs = np.unique(self.w_dofs)
-        dofs = dofs[dofs < self.size]
-        unit = np.zeros((self.size, dofs.size))
-        unit[dofs, np.arange(dofs.size)] = 1.0
-        self.green = np.zeros((dofs.size + 1, dofs.size + 1))
-        self.green[:-1, :-1] = np.asarray(nm.solve(unit))[dofs]
-        self.slot = np.full(self.size + 1, dofs.size, dtype=np.intp)
-        self.slot[dofs] = np.arange(dofs.size)
+        self.green, self.slot = girder_green(nm, self.size, dofs[dofs < self.size])
         self.kept = tuple(np.zeros(self.size) for _ in range(3))
         modes = sum(m.rho.size for m in interiors.modes)
         self._modal = tuple(np.zeros(modes, complex) for _ in range(3))
@@ -79,10 +74,9 @@ class CondensedGirders:
         """Return the condensed system of a train's structure, or None (nothing to condense)."""
         st, nm = train.structure, train.nm
         blocks = [p.block for p in st.piled if p.block is not None]
-        if not blocks or not hasattr(nm, 'dt'):
+        if not blocks:
             return None
-        interiors = condense_interiors(st.mass, st.damping, st.stiffness, blocks,
-                                       float(getattr(nm, 'dt')))
+        interiors = condense_interiors(st.mass, st.damping, st.stiffness, blocks, nm.dt)
         if interiors is None:
             return None
         index = interiors.kept_index
@@ -90,8 +84,7 @@ class CondensedGirders:
         if not np.array_equal(index[girder], girder):   # the loop's wheels index the girders
             return None
         mass, damping, stiffness = interiors.kept_matrices(st.mass, st.damping, st.stiffness)
-        kept = Newmark(mass, damping, stiffness, float(getattr(nm, 'dt')),
-                       method=str(getattr(nm, 'method', 'qdldl')), lean=True, fused=True)
+        kept = Newmark(mass, damping, stiffness, nm.dt, method=nm.method, lean=True, fused=True)
         if kept.fused_arrays() is None:
             return None
         return cls(interiors, kept, train)

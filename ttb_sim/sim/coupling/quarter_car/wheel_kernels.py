@@ -255,7 +255,7 @@ def _advance_quarter_cars(head: float, speed: float, dt: float, steps: int,
     state : (u, v, a, z, zv, za, contact) -- girder and sprung masses
     wheels : (positions, element, dofs, n0, w, p, b, e, hs_v, hs_a, r, r1, r2)
     work : (history [h_a | h_v], load, x0, solve work)
-    interiors : (start, boundary, rho, sigma, weight, p_hat, e_hat, d_m, d_c, eta, e, pre)
+    interiors : (start, boundary, rho, sigma, p_hat, e_hat, d_m, d_c, eta, e, pre)
         Substructure interiors condensed out of the girder system
         (:meth:`~ttb_sim.sim.integrators.condensed.ModalInteriors.packed`, then their
         modal state and work vector); start = [0]: none, the whole system is in the
@@ -273,8 +273,7 @@ def _advance_quarter_cars(head: float, speed: float, dt: float, steps: int,
     u, v, a, z, zv, za, contact = state
     positions, element, dofs, n0, w, p, b, e, hs_v, hs_a, r, r1, r2 = wheels
     buffer, load, x0, scratch = work
-    (i_start, i_boundary, i_rho, i_sigma, i_weight, i_p, i_e_hat, i_dm, i_dc, i_eta, i_e,
-     i_pre) = interiors
+    i_start, i_boundary, i_rho, i_sigma, i_p, i_e_hat, i_dm, i_dc, i_eta, i_e, i_pre = interiors
     n = u.shape[0]
     h_a = buffer[:n]
     h_v = buffer[n:]
@@ -290,8 +289,8 @@ def _advance_quarter_cars(head: float, speed: float, dt: float, steps: int,
         history(u, v, a, a0, a1, h_v, h_a)
         load[:] = 0.0   # the coupling's other load is zero (as QuarterCarTrain.step)
         effective_load(indptr, indices, data, buffer, load, load)
-        interior_load(i_start, i_boundary, i_rho, i_sigma, i_weight, i_p, i_dm, i_dc, i_eta,
-                      i_e, i_pre, h_a, h_v, load)
+        interior_load(i_start, i_boundary, i_rho, i_sigma, i_p, i_dm, i_dc, i_eta, i_e, i_pre,
+                      h_a, h_v, load)
         _wheel_terms(positions, speed, h, n_el, length, w_dofs, h_v, h_a, a0, a1,
                      has_profile, r, r1, r2, ms, mu, k, c, d, q, z, zv, za, gravity, element,
                      dofs, n0, w, p, b, e, hs_v, hs_a, load)

@@ -45,7 +45,8 @@ from ttb_sim.model.constants import GRAVITY
 from ttb_sim.model.irregularity import GRID_SLACK, TrackIrregularity
 from ttb_sim.model.structure import Structure
 from ttb_sim.model.vehicle.train import QuarterCars
-from ttb_sim.sim.coupling.base import FreeDofState, girder_wheel_load, VehicleOutputs
+from ttb_sim.sim.coupling.base import (FreeDofState, girder_green, girder_wheel_load,
+                                       VehicleOutputs)
 from ttb_sim.sim.coupling.quarter_car import wheel_kernels
 from ttb_sim.sim.coupling.quarter_car.condensed_girders import CondensedGirders, NO_INTERIORS
 from ttb_sim.sim.integrators.protocol import Integrator
@@ -91,7 +92,7 @@ class QuarterCarCoupling:
         girder_dofs = np.unique(girder.w_dofs)
         girder_dofs = girder_dofs[girder_dofs < n_free]
         if 0 < girder_dofs.size <= DENSE_GIRDER_LIMIT:
-            self._green, self._slot = self._girder_green(girder_dofs)
+            self._green, self._slot = girder_green(integrator, n_free, girder_dofs)
         if compiled is None:
             compiled = bool(getattr(integrator, 'lean', False))
         self.compiled = (compiled and self._green is not None
@@ -112,22 +113,6 @@ class QuarterCarCoupling:
             found = (wheel_kernels.KERNELS.compiled(name) for name in (
                 'wheel_terms', 'green_correction', 'update_cars'))
             self._kernels = tuple(k for k in found if k is not None)
-
-    def _girder_green(self, girder_dofs: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """
-        Return the inverse effective matrix among the girder DOFs, and each DOF's slot in it.
-
-        The block gets one more row and column of zeros, the slot of the
-        constrained DOFs (index ``n_free`` in ``w_dofs``).
-        """
-        n_free, k = self.n_free, girder_dofs.size
-        unit = np.zeros((n_free, k))
-        unit[girder_dofs, np.arange(k)] = 1.0
-        green = np.zeros((k + 1, k + 1))
-        green[:k, :k] = np.asarray(self.nm.solve(unit))[girder_dofs]
-        slot = np.full(n_free + 1, k, dtype=np.intp)
-        slot[girder_dofs] = np.arange(k)
-        return green, slot
 
     def step(self, u: np.ndarray, v: np.ndarray, a: np.ndarray, force: np.ndarray,
              positions: np.ndarray, speed: float,

@@ -450,15 +450,10 @@ class ReducedTrainTrackCoupling(TrainTrackCoupling):
         t, local = window.basis, window.local_basis
         mass, damping, stiffness = (project(st.mass, local), project(st.damping, local),
                                     project(st.stiffness, t))
-        if self.rail_steps:
-            # every window, not only the whole track at build: the exchange must hold here
-            fast = self._fast_dofs(window)
-            check_coupling(mass, damping, stiffness, fast,
-                           np.setdiff1d(np.arange(window.size), fast), self._dt,
-                           self.rail_steps)
+        # check=True: every window's exchange is checked, not only the whole track's at build
         self.nm = (MultiRateNewmark(mass, damping, stiffness, self._dt,
                                     self._fast_dofs(window), self.rail_steps,
-                                    method=self._method, check=False)
+                                    method=self._method, check=True)
                    if self.rail_steps else
                    Newmark(mass, damping, stiffness, self._dt, method=self._method, lean=True))
         self.static_stiffness = self.nm.stiffness
