@@ -140,6 +140,10 @@ def _add_model_verbs(sub: Any) -> None:
                     metavar='KEY=VALUE', help='override a scenario key; repeatable')
     fr.add_argument('--json', type=Path, metavar='FILE', help='also write the receptances')
     fr.add_argument('--plot', type=Path, metavar='FILE', help='also draw them (PNG)')
+    fr.add_argument('--at', default='load', help="load (default): the scenario's load and "
+                    "pile head; master: the piled pier's ground seen from the cap's master "
+                    '(6 x 6 dynamic stiffness), with the reduced substructure the time '
+                    'stepping uses beside it')
 
 
 def _add_bag_verbs(sub: Any) -> None:
@@ -366,7 +370,7 @@ def _main(argv: Sequence[str] | None) -> int:
             from ttb_sim.commands.frf import frf_command
             return frf_command(args.scenario, args.freqs, pml=args.pml, refine=args.refine,
                                solver=args.solver, overrides=args.overrides,
-                               json_path=args.json, plot_path=args.plot)
+                               json_path=args.json, plot_path=args.plot, at=args.at)
         if args.command == 'modes':
             from ttb_sim.commands.modes import modes_command
             return modes_command(args.scenario, around=args.around, count=args.count,

@@ -88,3 +88,37 @@ def test_the_table_json_and_figure_hold_the_solver_numbers(
     for f, m in zip((2.0, 6.0), moved):
         assert f'{100 * m:7.2f}%' in table
     assert png.stat().st_size > 10_000
+
+
+#: live_coupled's piled pier on a coarse 24 m block (about 6 000 DOFs, a second in all).
+COARSE_PIER = ['--set', 'soil.block.lx=24', '--set', 'soil.block.ly=18', '--set',
+               'soil.mesh.h=3', '--set', 'soil.mesh.h_max=6']
+
+
+@pytest.mark.parametrize('args, match', [
+    (['frf', 'live_coupled', '--at', 'pier'], "--at = 'pier': allowed values are load, master"),
+    (['frf', 'single_pile', '--at', 'master'], 'no pile cap'),
+])
+def test_master_refusals_exit_2_with_one_line(args: list[str], match: str,
+                                              capsys: pytest.CaptureFixture[str]) -> None:
+    assert main(args) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and match in err[0], err
+
+
+def test_at_master_sets_the_reduced_substructure_beside_the_unreduced_mesh(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """The reduced block keeps the statics (1e-9) and the JSON holds what the table shows."""
+    out, png = tmp_path / 'master.json', tmp_path / 'master.png'
+    assert main(['frf', 'live_coupled', '--at', 'master', '--freqs', '0,2', '--json',
+                 str(out), '--plot', str(png), *COARSE_PIER]) == 0
+    table = capsys.readouterr().out
+    assert 'reduced max' in table and "cap's master" in table
+    report = json.loads(out.read_text())
+    assert [c['label'] for c in report['cases']] == ['scenario', 'reduced']
+    errors = report['cases'][1]['errors']
+    assert max(v[0] for k, v in errors.items() if k.startswith('Z_')) <= 1e-9   # 0 Hz
+    z = np.array(report['cases'][0]['impedance']) @ np.array([1.0, 1j])
+    assert z.shape == (2, 6, 6) and np.abs(z[0].imag).max() == 0.0   # no damping at rest
+    assert f'{abs(z[1, 2, 2]):12.4e}' in table
+    assert png.stat().st_size > 10_000

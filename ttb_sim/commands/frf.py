@@ -34,7 +34,7 @@ import json
 import logging
 import math
 from pathlib import Path
-from typing import Any, Optional, Sequence
+from typing import Any, Callable, Optional, Sequence
 
 import numpy as np
 
@@ -49,6 +49,9 @@ MAX_FREQUENCIES = 200
 """Most frequencies one call solves."""
 
 SOLVERS = ('auto', 'pardiso', 'superlu')
+
+AT = ('load', 'master')
+"""What ``--at`` may name: the scenario's load point, or the piled pier's cap master."""
 
 SLOW_SECONDS = 20.0
 """Estimated time left (s) above which each solve is reported on the terminal."""
@@ -108,19 +111,24 @@ def _halved(spec: Any) -> Any:
     return replace(spec, soil=replace(spec.soil, mesh=finer))
 
 
+def _progress(label: str, count: int) -> Callable[[int, float, float], None]:
+    """Return a solve's progress report: on the terminal (WARNING) when it is long."""
+    def progress(i: int, f: float, seconds: float) -> None:
+        left = seconds * (count - i - 1)
+        level = logging.WARNING if left > SLOW_SECONDS else logging.INFO
+        log.log(level, 'frf %s: %g Hz solved in %.1f s (%d of %d; about %.0f s left)', label,
+                f, seconds, i + 1, count, left)
+
+    return progress
+
+
 def _case(spec: Any, load: Any, freqs: list[float], pml: Optional[float], solver: str,
           label: str) -> dict[str, Any]:
     from ttb_sim.model.foundation.frequency_response import MatchedLayer, substructure_response
 
-    def progress(i: int, f: float, seconds: float) -> None:
-        # long work shows its progress on the terminal (WARNING), quick work only with -v
-        level = logging.WARNING if seconds * (len(freqs) - i - 1) > SLOW_SECONDS else \
-            logging.INFO
-        log.log(level, 'frf %s: %g Hz solved in %.1f s (%d of %d; about %.0f s left)', label,
-                f, seconds, i + 1, len(freqs), seconds * (len(freqs) - i - 1))
-
     layer = MatchedLayer(pml) if pml is not None else None
-    r = substructure_response(spec, load, freqs, layer=layer, method=solver, progress=progress)
+    r = substructure_response(spec, load, freqs, layer=layer, method=solver,
+                              progress=_progress(label, len(freqs)))
     axis = 'xyz'.index(load.direction)
     head = r.heads[:, load.pile - 1, axis] if load.target in ('pile', 'cap') else \
         np.full(len(freqs), np.nan + 0j)
@@ -151,7 +159,7 @@ def _pier_load(loaded: Any) -> Any:
 
 def frf_report(scenario: str | Path, freqs: Sequence[float], *, pml: Optional[float] = None,
                refine: bool = False, solver: str = 'auto',
-               overrides: Sequence[str] = ()) -> dict[str, Any]:
+               overrides: Sequence[str] = (), at: str = 'load') -> dict[str, Any]:
     """
     Return the receptances of a substructure scenario (and of its halved mesh).
 
@@ -162,7 +170,8 @@ def frf_report(scenario: str | Path, freqs: Sequence[float], *, pml: Optional[fl
         ('boundary' name or 'pml'), and 'cases': one per mesh ('scenario', then
         'halved'), each with 'dofs', 'unknowns', 'solver', 'symmetry', 'seconds'
         and complex receptances (m/N) 'head' (the loaded pile, along the load)
-        and 'points' (name -> receptance along the load).
+        and 'points' (name -> receptance along the load). With ``at='master'``
+        the report of :func:`~.frf_master.master_report` instead.
 
     """
     _check_options(pml, solver, ())
@@ -170,11 +179,18 @@ def frf_report(scenario: str | Path, freqs: Sequence[float], *, pml: Optional[fl
 
     loaded = load_scenario(scenario, overrides)
     spec = loaded.substructure('pier01')
-    load = loaded.load if loaded.substructure_only else _pier_load(loaded)
     values = [float(f) for f in freqs]
     if pml is not None and min(values) <= 0:
         raise ScenarioError('--freqs: a perfectly matched layer (--pml) needs frequencies '
                             'above 0 Hz')
+    if at == 'master':
+        from ttb_sim.commands.frf_master import check_master_scenario, master_report
+
+        check_master_scenario(loaded)
+        return master_report(loaded, spec, values, pml=pml, refine=refine, solver=solver,
+                             progress=lambda label: _progress(label, len(values)),
+                             halved=_halved)
+    load = loaded.load if loaded.substructure_only else _pier_load(loaded)
     cases = [_case(spec, load, values, pml, solver, 'scenario')]
     if refine:
         cases.append(_case(_halved(spec), load, values, pml, solver, 'halved'))
@@ -259,12 +275,24 @@ def plot_frf(report: dict[str, Any], path: Path) -> Path:
 
 def frf_command(scenario: str, freqs: str, *, pml: Optional[float] = None,
                 refine: bool = False, solver: str = 'auto', overrides: Sequence[str] = (),
-                json_path: Optional[Path] = None, plot_path: Optional[Path] = None) -> int:
+                json_path: Optional[Path] = None, plot_path: Optional[Path] = None,
+                at: str = 'load') -> int:
     """Run ``ttb-sim frf``: print the table (and write JSON and a figure); return 0."""
     values = parse_frequencies(freqs)
     _check_options(pml, solver, (json_path, plot_path))
+    if at not in AT:
+        raise ScenarioError(f'--at = {shown(at)}: allowed values are ' + ', '.join(AT))
     report = frf_report(scenario, values, pml=pml, refine=refine, solver=solver,
-                        overrides=overrides)
+                        overrides=overrides, at=at)
+    if at == 'master':
+        from ttb_sim.commands.frf_master import format_master, jsonable_master, plot_master
+
+        print(format_master(report))
+        if json_path is not None:
+            json_path.write_text(json.dumps(jsonable_master(report), indent=1))
+        if plot_path is not None:
+            plot_master(report, plot_path)
+        return 0
     print(format_frf(report))
     if json_path is not None:
         json_path.write_text(json.dumps(_jsonable(report), indent=1))

@@ -33,7 +33,7 @@ from ttb_sim.config.conditions import (bearing_factors, check_conditions, condit
                                        conditioned_bridge, girder_bending, pier_substructure)
 from ttb_sim.config.sensor_places import ProbeRequest
 from ttb_sim.errors import ScenarioError
-from ttb_sim.fe.beam import field_rows, point_rows
+from ttb_sim.fe.beam import BeamSection, field_rows, point_rows
 from ttb_sim.inputs import shown
 from ttb_sim.model.beam_line import BeamLine
 from ttb_sim.model.bridge import pier_section, rayleigh_coefficients, span_frequency
@@ -103,15 +103,25 @@ def build_foundation(scenario: Scenario, spec: Substructure | None = None
     """
     from ttb_sim.model.foundation.reduction import pile_soil_operator
 
-    b, pr = conditioned_bridge(scenario), scenario.piers
-    f1 = span_frequency(b.span_length, b.bending_stiffness, b.mass_per_length)
     spec = scenario.substructure() if spec is None else spec
-    operator = pile_soil_operator(spec, pr.height, pr.elements,
-                                  pier_section(pr),
-                                  rayleigh_coefficients(b.damping_ratio, f1, 4 * f1),
+    operator = pile_soil_operator(spec, *pier_column_parameters(scenario),
                                   scenario.soil.reduction)
     warn_unresolved_loading(scenario, float(operator.summary.get('f_max', np.inf)))
     return operator
+
+
+def pier_column_parameters(scenario: Scenario
+                           ) -> tuple[float, int, BeamSection, tuple[float, float]]:
+    """
+    Return a piled pier's column: (height, elements, section, Rayleigh (a0, a1)).
+
+    Damped like the bridge's beams: the girder's ratio at its first and fourth
+    bending frequencies, at the scenario's temperature.
+    """
+    b, pr = conditioned_bridge(scenario), scenario.piers
+    f1 = span_frequency(b.span_length, b.bending_stiffness, b.mass_per_length)
+    return (pr.height, pr.elements, pier_section(pr),
+            rayleigh_coefficients(b.damping_ratio, f1, 4 * f1))
 
 
 def warn_unresolved_loading(scenario: Scenario, f_max: float) -> bool:

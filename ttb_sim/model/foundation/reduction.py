@@ -419,3 +419,28 @@ def _one_blas_thread() -> Iterator[None]:
         return
     with threadpool_limits(limits=1, user_api='blas'):
         yield
+
+
+def substructure_block(op: FoundationOperator, pier_height: float, pier_elements: int,
+                       pier_section: BeamSection, pier_rayleigh: tuple[float, float]
+                       ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """
+    Return the reduced substructure under the column: (M, C, K, head rows, soil-point rows).
+
+    The coordinates are [master (6), the basis's]: ``op`` (of
+    :func:`pile_soil_operator` with the same column) less its column, the model
+    the time stepping uses, seen from the cap's master as
+    :func:`~.master_response.master_response` sees the unreduced one.
+    """
+    column = _column(pier_height, pier_elements, pier_section, pier_rayleigh)
+    lead = column[0].shape[0] - NODE_DOFS
+    if op.size <= lead + NODE_DOFS or op.summary.get('column_dofs') != lead + NODE_DOFS:
+        raise FoundationError(f'the operator has {op.summary.get("column_dofs")} column DOFs, '
+                              f'the column given {lead + NODE_DOFS}')
+    blocks = []
+    for full, col in zip((op.mass, op.damping, op.stiffness), column):
+        sub = np.array(full[lead:, lead:], dtype=float)
+        sub[:NODE_DOFS, :NODE_DOFS] -= col[lead:, lead:]
+        blocks.append(sub)
+    return (blocks[0], blocks[1], blocks[2], np.asarray(op.pile_heads)[:, lead:],
+            np.asarray(op.soil_points)[:, lead:])

@@ -89,8 +89,13 @@ def check_spec(spec: Substructure) -> None:
                               "or 'rigid_base'")
 
 
-def tie_cap(model: PileSoilModel) -> TiedSubstructure:
-    """Return the linear model with the cap top tied rigidly to a master at its centre."""
+def cap_tie(model: PileSoilModel) -> tuple[sp.csr_matrix, np.ndarray, np.ndarray]:
+    """
+    Return the tie of the cap top to its master: (T, kept, master).
+
+    u = T x with x = [master (6), the free DOFs ``kept`` not on the cap top];
+    ``master`` is the group centre on the cap top (m).
+    """
     spec = model.spec
     check_spec(spec)
     assert spec.piles is not None
@@ -116,6 +121,12 @@ def tie_cap(model: PileSoilModel) -> TiedSubstructure:
     transform = sp.csr_matrix((np.concatenate(vals), (np.concatenate(rows),
                                                       np.concatenate(cols))),
                               shape=(n_dofs, 6 + len(kept)))
+    return transform, kept, master
+
+
+def tie_cap(model: PileSoilModel) -> TiedSubstructure:
+    """Return the linear model with the cap top tied rigidly to a master at its centre."""
+    transform, _, master = cap_tie(model)
     k = model.linear_stiffness() + model.initial_interface_stiffness()
     c = model.linear_damping()
     m = sp.diags(model.mass)
