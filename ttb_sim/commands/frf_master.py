@@ -80,7 +80,7 @@ def _reduced_response(loaded: Any, values: Sequence[float]) -> Any:
         return None
     from ttb_sim.model.foundation.master_response import dense_master_response
     from ttb_sim.model.foundation.reduction import substructure_block
-    from ttb_sim.sim.build import build_foundation, pier_column_parameters
+    from ttb_sim.sim import build_foundation, pier_column_parameters
 
     op = build_foundation(loaded)
     m, c, k, heads, points = substructure_block(op, *pier_column_parameters(loaded))

@@ -24,7 +24,8 @@ The names below are the package's face: the layers above (commands, node,
 validation) take what they need of the stepping core from here.
 """
 
-from ttb_sim.sim.build import build_structure, build_vehicle, probe_rows, ProbeRows
+from ttb_sim.sim.build import (build_foundation, build_structure, build_vehicle,
+                               pier_column_parameters, probe_rows, ProbeRows)
 from ttb_sim.sim.cost import CostEstimate, estimate_cost, STEP_BUDGET
 from ttb_sim.sim.frames import Frame, Layout, SOIL_VALUES
 from ttb_sim.sim.integrators.newmark import Newmark
@@ -33,7 +34,8 @@ from ttb_sim.sim.simulation import Simulation
 from ttb_sim.sim.substructure import reference_refusal, substructure_dof_counts, SubstructureRun
 from ttb_sim.sim.variants import blas_threads, solver_variant, VARIANTS
 
-__all__ = ['blas_threads', 'build_structure', 'build_vehicle', 'CostEstimate', 'estimate_cost',
-           'Frame', 'Layout', 'make_runner', 'Newmark', 'probe_rows', 'ProbeRows',
-           'reference_refusal', 'Runner', 'Simulation', 'SOIL_VALUES', 'solver_variant',
-           'STEP_BUDGET', 'substructure_dof_counts', 'SubstructureRun', 'VARIANTS']
+__all__ = ['blas_threads', 'build_foundation', 'build_structure', 'build_vehicle',
+           'CostEstimate', 'estimate_cost', 'Frame', 'Layout', 'make_runner', 'Newmark',
+           'pier_column_parameters', 'probe_rows', 'ProbeRows', 'reference_refusal', 'Runner',
+           'Simulation', 'SOIL_VALUES', 'solver_variant', 'STEP_BUDGET',
+           'substructure_dof_counts', 'SubstructureRun', 'VARIANTS']

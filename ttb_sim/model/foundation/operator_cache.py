@@ -35,6 +35,7 @@ import numpy as np
 import scipy
 
 from ttb_sim.fe.beam import BeamSection
+from ttb_sim.fe.complex_solve import resolve_method
 from ttb_sim.fe.factorization import resolve
 from ttb_sim.model.foundation.krylov import FACTORIZATION
 from ttb_sim.model.foundation.operator import FoundationOperator, InterfaceRows
@@ -60,6 +61,8 @@ def cache_key(spec: Substructure, pier_height: float, pier_elements: int,
     text = repr((FORMAT, resolve(FACTORIZATION), np.__version__, scipy.__version__, spec,
                  float(pier_height), int(pier_elements),
                  tuple(float(v) for v in pier_rayleigh), reduction))
+    if reduction.shift_axis == 'imaginary':   # the complex pencils' solver (PARDISO or not)
+        text += repr(resolve_method('auto'))
     digest.update(text.encode())
     for name in ('ea', 'gj', 'ei_y', 'ei_z', 'mass', 'inertia_x'):
         digest.update(np.ascontiguousarray(getattr(pier_section, name), dtype=float).tobytes())

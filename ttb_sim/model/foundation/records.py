@@ -164,9 +164,10 @@ class ReductionParameters:
         '(shift s = 2 pi f, or i 2 pi f, see soil.reduction.shift_axis); 0 = about the '
         'static solution.', low=0.0, high=1000.0)
     shift_axis: str = param('real', '-', "Where the shifts lie: 'imaginary' = s = i 2 pi "
-                            'f, the complex pencil K - w^2 M + i w C factorised by LDL^T of its '
-                            "real 2n form; 'real' = s = 2 pi f, the positive definite K + s C + "
-                            's^2 M (Cholesky).', choices=('imaginary', 'real'))
+                            'f, the complex pencil K - w^2 M + i w C factorised by MKL PARDISO '
+                            '(the pardiso extra) or else by LDL^T of its real 2n form; '
+                            "'real' = s = 2 pi f, the positive definite K + s C + s^2 M "
+                            '(Cholesky).', choices=('imaginary', 'real'))
     levels: int = param(8, '-', 'Krylov levels per shift (each adds up to 6 vectors).',
                         low=1, high=100)
     tolerance: float = param(1e-9, '-', 'Deflation: a new direction is dropped when its '
