@@ -28,8 +28,8 @@ import numpy as np
 import pytest
 
 from ttb_sim.validation.references.half_space import (HalfSpace, rayleigh_speed,
-                                                      square_patch_compliance,
-                                                      SQUARE_MEAN_SETTLEMENT, surface_kernel)
+                                                      SQUARE_MEAN_SETTLEMENT,
+                                                      square_patch_compliance, surface_kernel)
 
 SOIL = HalfSpace(5e6, 0.25, 1900.0, alpha=0.6, beta=7.6e-4)
 
