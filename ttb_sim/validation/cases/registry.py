@@ -35,6 +35,7 @@ from ttb_sim.validation.cases.components import COMPONENT_CASES
 from ttb_sim.validation.cases.conditions import CONDITION_CASES
 from ttb_sim.validation.cases.coupled import COUPLED_CASES
 from ttb_sim.validation.cases.damage import DAMAGE_CASES
+from ttb_sim.validation.cases.half_space import HALF_SPACE_CASES
 from ttb_sim.validation.cases.modal import MODAL_CASES
 from ttb_sim.validation.cases.pile_group import PILE_GROUP_CASES
 from ttb_sim.validation.cases.pile_soil import PILE_SOIL_CASES
@@ -175,7 +176,7 @@ CASES: dict[str, Case] = {c.case_id: c for c in sorted((
     Case('V7', 'Newmark average acceleration: order and energy', _v7),
     *COMPONENT_CASES, *SLAB_PLATE_CASES, *SYSTEM_CASES, *TRACK_CASES, *PILE_SOIL_CASES,
     *PILE_GROUP_CASES, *ANALYSIS_CASES, *COUPLED_CASES, *DAMAGE_CASES, *SENSOR_CASES,
-    *CONDITION_CASES, *MODAL_CASES, *TWIN_CASES),
+    *CONDITION_CASES, *MODAL_CASES, *TWIN_CASES, *HALF_SPACE_CASES),
     key=lambda c: (c.case_id[0] != 'V', int(c.case_id[1:])))}
 """Cases by id: V* are VALIDATION.md's, X* are extra checks of modelling choices."""
 
