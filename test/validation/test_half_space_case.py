@@ -39,7 +39,8 @@ SMALL = {'block': 5.0, 'depth': 4.0}
 
 @pytest.fixture(scope='module')
 def small_block() -> tuple[np.ndarray, complex]:
-    fe = np.array([footing_receptances(SIDE / n, [5.0], pml=3.0, **SMALL)[0] for n in (2, 4)])
+    fe = np.array([footing_receptances(SIDE / n, [5.0], pml=3.0, **SMALL)[0, 0]
+                   for n in (2, 4)])
     exact = square_patch_compliance(half_space_of(soil_footing(SIDE / 2, **SMALL)), 5.0, SIDE)
     return fe, exact
 

@@ -110,8 +110,8 @@ def stretched(grad: np.ndarray, det: np.ndarray, stretch: Optional[np.ndarray]
 
 
 def strain_matrices(grad: np.ndarray) -> np.ndarray:
-    """Return B (strain = B u_e) from shape-function gradients, shape (..., 6, 24)."""
-    b = np.zeros(grad.shape[:-2] + (6, 24), dtype=grad.dtype)
+    """Return B (strain = B u_e) from n functions' gradients (..., n, 3): (..., 6, 3n)."""
+    b = np.zeros(grad.shape[:-2] + (6, 3 * grad.shape[-2]), dtype=grad.dtype)
     gx, gy, gz = grad[..., 0], grad[..., 1], grad[..., 2]
     b[..., 0, 0::3] = gx
     b[..., 1, 1::3] = gy
@@ -125,8 +125,64 @@ def strain_matrices(grad: np.ndarray) -> np.ndarray:
     return b
 
 
+def incompatible_gradients(xi: np.ndarray) -> np.ndarray:
+    """
+    Return dP_k/dxi_j of Wilson's incompatible modes P_k = 1 - xi_k^2, shape (p, 3, 3).
+
+    Three modes (k = x, y, z) per displacement component: the bending an 8-node
+    brick cannot take, which it otherwise resists by spurious shear (locking).
+    """
+    xi = np.atleast_2d(xi)
+    g = np.zeros((xi.shape[0], 3, 3))
+    idx = np.arange(3)
+    g[:, idx, idx] = -2.0 * xi
+    return g
+
+
+_DP = incompatible_gradients(GAUSS_POINTS)
+_DN_CENTRE = shape_gradients(np.zeros(3))[0]
+
+
+def _incompatible_physical(coords: np.ndarray, det: np.ndarray) -> np.ndarray:
+    """
+    Return the incompatible modes' gradients (m, 8g, 3, 3) at the Gauss points.
+
+    Taylor, Beresford & Wilson (1976): from the Jacobian at the centre, scaled by
+    det J_0 / det J_g, so that their integral over any element is zero and a
+    constant strain is reproduced exactly (the patch test) on distorted bricks.
+    """
+    jac0 = np.einsum('ai,eaj->eij', _DN_CENTRE, coords)
+    det0 = np.linalg.det(jac0)
+    grad = np.einsum('eij,gkj->egki', np.linalg.inv(jac0), _DP)
+    return grad * (det0[:, None] / det)[:, :, None, None]
+
+
+def _elastic_form(grad: np.ndarray, det: np.ndarray, young: np.ndarray,
+                  poisson: np.ndarray) -> np.ndarray:
+    """
+    Return sum_g w det B^T D B for n scalar functions' gradients (m, 8g, n, 3): (m, 3n, 3n).
+
+    DOFs ordered (u_x, u_y, u_z) per function.
+    """
+    m, _, n, _ = grad.shape
+    young = np.asarray(young, dtype=float)
+    poisson = np.broadcast_to(np.asarray(poisson, dtype=float), young.shape)
+    lam = young * poisson / ((1 + poisson) * (1 - 2 * poisson))
+    mu = young / (2 * (1 + poisson))
+    # A[a i, b j] = sum_g w det g_ai g_bj; K_aibj = lam A_aibj + mu A_ajbi + mu delta_ij A_akbk
+    g = grad.reshape(m, grad.shape[1], 3 * n)
+    a = np.matmul(np.swapaxes(g * (det * GAUSS_WEIGHTS)[:, :, None], 1, 2), g)
+    a5 = a.reshape(m, n, 3, n, 3)
+    trace = np.einsum('eaibi->eab', a5)
+    k = lam[:, None, None, None, None] * a5 + mu[:, None, None, None, None] * \
+        np.swapaxes(a5, 2, 4)
+    idx = np.arange(3)
+    k[:, :, idx, :, idx] += mu[None, :, None, None] * trace[None]
+    return k.reshape(m, 3 * n, 3 * n)
+
+
 def stiffness(coords: np.ndarray, young: np.ndarray, poisson: np.ndarray,
-              stretch: Optional[np.ndarray] = None) -> np.ndarray:
+              stretch: Optional[np.ndarray] = None, incompatible: bool = False) -> np.ndarray:
     """
     Return element stiffness matrices K_e = sum_g w_g det J_g B_g^T D B_g.
 
@@ -139,6 +195,10 @@ def stiffness(coords: np.ndarray, young: np.ndarray, poisson: np.ndarray,
     stretch : complex array, shape (m, 8, 3), optional
         Complex coordinate stretch (s_x, s_y, s_z) at each Gauss point, for a
         perfectly matched layer in the frequency domain (:func:`stretched`).
+    incompatible : bool
+        Enrich each brick with Wilson's nine incompatible modes
+        (:func:`incompatible_gradients`, Taylor's patch-test form), condensed
+        out element by element: the same DOFs, no shear locking in bending.
 
     Returns
     -------
@@ -146,33 +206,41 @@ def stiffness(coords: np.ndarray, young: np.ndarray, poisson: np.ndarray,
         Shape (m, 24, 24), N/m; complex (and complex symmetric) with a stretch.
 
     """
-    grad, det = stretched(*_jacobians(np.asarray(coords, dtype=float)), stretch)
-    m = len(grad)
-    young = np.asarray(young, dtype=float)
-    poisson = np.broadcast_to(np.asarray(poisson, dtype=float), young.shape)
-    lam = young * poisson / ((1 + poisson) * (1 - 2 * poisson))
-    mu = young / (2 * (1 + poisson))
-    # A[a i, b j] = sum_g w det g_ai g_bj; K_aibj = lam A_aibj + mu A_ajbi + mu delta_ij A_akbk
-    g = grad.reshape(m, 8, 24)
-    a = np.matmul(np.swapaxes(g * (det * GAUSS_WEIGHTS)[:, :, None], 1, 2), g)
-    a5 = a.reshape(m, 8, 3, 8, 3)
-    trace = np.einsum('eaibi->eab', a5)
-    k = lam[:, None, None, None, None] * a5 + mu[:, None, None, None, None] * \
-        np.swapaxes(a5, 2, 4)
-    idx = np.arange(3)
-    k[:, :, idx, :, idx] += mu[None, :, None, None] * trace[None]
-    return k.reshape(m, 24, 24)
+    coords = np.asarray(coords, dtype=float)
+    grad, det = _jacobians(coords)
+    if incompatible:
+        extra = _incompatible_physical(coords, det)
+        grad = np.concatenate([grad, extra], axis=2)
+    grad, det = stretched(grad, det, stretch)
+    k = _elastic_form(grad, det, young, poisson)
+    if not incompatible:
+        return k
+    k_uu, k_ua, k_aa = k[:, :24, :24], k[:, :24, 24:], k[:, 24:, 24:]
+    return k_uu - np.matmul(k_ua, np.linalg.solve(k_aa, np.swapaxes(k_ua, 1, 2)))
 
 
 def stiffness_reference(coords: np.ndarray, young: np.ndarray, poisson: np.ndarray,
-                        stretch: Optional[np.ndarray] = None) -> np.ndarray:
-    """Return K_e = sum_g w_g det J_g B_g^T D B_g with explicit B matrices (slow; for tests)."""
-    grad, det = stretched(*_jacobians(np.asarray(coords, dtype=float)), stretch)
+                        stretch: Optional[np.ndarray] = None,
+                        incompatible: bool = False) -> np.ndarray:
+    """
+    Return K_e = sum_g w_g det J_g B_g^T D B_g with explicit B matrices (slow; for tests).
+
+    With ``incompatible``, B has the nine incompatible modes' columns too and
+    they are condensed out by an explicit inverse of their block.
+    """
+    coords = np.asarray(coords, dtype=float)
+    grad, det = _jacobians(coords)
+    if incompatible:
+        grad = np.concatenate([grad, _incompatible_physical(coords, det)], axis=2)
+    grad, det = stretched(grad, det, stretch)
     b = strain_matrices(grad)
     d = elasticity(young, poisson)
     db = np.matmul(d[:, None], b)
     k = np.matmul(np.swapaxes(b, 2, 3), db * (det * GAUSS_WEIGHTS)[:, :, None, None])
-    return k.sum(axis=1)
+    k = k.sum(axis=1)
+    if incompatible:
+        k = k[:, :24, :24] - k[:, :24, 24:] @ np.linalg.inv(k[:, 24:, 24:]) @ k[:, 24:, :24]
+    return k
 
 
 def volumes(coords: np.ndarray) -> np.ndarray:

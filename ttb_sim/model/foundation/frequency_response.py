@@ -227,6 +227,7 @@ class DynamicStiffness:
             self._dofs = node_dofs(model.mesh.cells)[sel]
             self._elastic = (mats.young[mat], mats.poisson[mat], mats.density[mat])
             self._rayleigh = (mats.alpha[mat], mats.beta[mat])
+            self._enriched = model.spec.mesh.element == 'hex8i'
             self._gauss = np.einsum('ga,eai->egi', hex8.shape_functions(hex8.GAUSS_POINTS),
                                     self._coords)
             # the same cells unstretched, once: Z_plain(w) = (1 + i w beta) K + (i w alpha - w^2) M
@@ -264,7 +265,8 @@ class DynamicStiffness:
 
         def kernel(ids: np.ndarray) -> np.ndarray:
             part = None if s is None else s[ids]
-            k = hex8.stiffness(self._coords[ids], young[ids], poisson[ids], part)
+            k = hex8.stiffness(self._coords[ids], young[ids], poisson[ids], part,
+                               incompatible=self._enriched)
             out = (k_weight + beta_weight * beta[ids])[:, None, None] * k
             m = hex8.lumped_mass(self._coords[ids], rho[ids], part)
             diag = ((alpha_weight * alpha[ids] + mass_weight)[:, None] * m).repeat(3, axis=1)

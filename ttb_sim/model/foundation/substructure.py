@@ -244,10 +244,11 @@ def build(spec: Substructure, load: Optional[PileLoad] = None) -> PileSoilModel:
     lumped = hex8.lumped_mass(cut.coordinates, mats.density[tags.material])
     mass = np.bincount(np.repeat(cells.ravel(), 3) * 3 + np.tile(np.arange(3), cells.size),
                        weights=np.repeat(lumped.ravel(), 3), minlength=n_dofs)
+    enriched = spec.mesh.element == 'hex8i'
     k_soil, c_soil = _linear_operators(np.flatnonzero(tags.kind == SOIL), dofs, cut.coordinates,
-                                       tags.material, mats, lumped, n_dofs)
+                                       tags.material, mats, lumped, n_dofs, enriched)
     k_str, c_str = _linear_operators(np.flatnonzero(tags.kind != SOIL), dofs, cut.coordinates,
-                                     tags.material, mats, lumped, n_dofs)
+                                     tags.material, mats, lumped, n_dofs, enriched)
     structure_dofs = np.zeros(n_dofs, dtype=bool)
     structure_dofs[dofs[tags.kind != SOIL].ravel()] = True
     free, k_b, c_b = _boundary(spec, mesh, outer, cut.coordinates, mats, n_dofs)
@@ -312,9 +313,12 @@ def materials(spec: Substructure) -> Materials:
 
 def _linear_operators(sel: np.ndarray, dofs: np.ndarray, coords: np.ndarray,
                       material: np.ndarray, mats: Materials, lumped: np.ndarray,
-                      n_dofs: int) -> tuple[sp.csr_matrix, sp.csr_matrix]:
+                      n_dofs: int, incompatible: bool = False
+                      ) -> tuple[sp.csr_matrix, sp.csr_matrix]:
     """
     Return the stiffness K and Rayleigh damping alpha M + beta K of the cells ``sel``.
+
+    ``incompatible``: bricks with Wilson's incompatible modes (``soil.mesh.element``).
 
     K and beta K are assembled together, as the real and imaginary parts of one
     complex matrix, so that they share one pattern.
@@ -325,7 +329,8 @@ def _linear_operators(sel: np.ndarray, dofs: np.ndarray, coords: np.ndarray,
 
     def kernel(ids: np.ndarray) -> np.ndarray:
         e = sel[ids]
-        k = hex8.stiffness(coords[e], mats.young[material[e]], mats.poisson[material[e]])
+        k = hex8.stiffness(coords[e], mats.young[material[e]], mats.poisson[material[e]],
+                           incompatible=incompatible)
         return k * (1.0 + 1j * mats.beta[material[e]])[:, None, None]
 
     both = assemble_chunked(n_dofs, dofs[sel], kernel, dtype=complex)

@@ -138,18 +138,36 @@ def rayleigh_speed(poisson: float) -> float:
     return 0.5 * (lo + hi)
 
 
-def _patch_angular(k: float, side: float, n: int) -> float:
-    """Return the integral over the angle of the square's transform squared at |k| = k."""
+def _patch_angular(k: float, side: float, n: int, x: float | None = None) -> float:
+    """
+    Return an integral over the angle at |k| = k of the square's transform.
+
+    With ``x`` None: of the transform squared (the mean over the square); else of
+    the transform times cos(k x cos(theta)) (the surface point (x, 0)).
+    """
     theta = (np.arange(n) + 0.5) * (0.5 * math.pi / n)   # midpoints on [0, pi / 2]
     half = 0.5 * k * side
     s = np.sinc(half * np.cos(theta) / math.pi) * np.sinc(half * np.sin(theta) / math.pi)
-    return 4.0 * float(np.sum(s * s)) * (0.5 * math.pi / n)
+    weight = s if x is None else np.cos(k * x * np.cos(theta))
+    return 4.0 * float(np.sum(s * weight)) * (0.5 * math.pi / n)
+
+
+def _inverse_distance_integral(x: float, side: float) -> float:
+    """Return the integral of 1 / r over the square centred at 0, seen from (x, 0, 0) (m)."""
+    def primitive(u: float, v: float) -> float:
+        r = math.hypot(u, v)
+        return (u * math.log(v + r) if u else 0.0) + v * math.log(u + r)
+
+    lo, hi = -0.5 * side, 0.5 * side
+    return (primitive(hi - x, hi) - primitive(lo - x, hi) - primitive(hi - x, lo)
+            + primitive(lo - x, lo))
 
 
 def square_patch_compliance(space: HalfSpace, frequency: float, side: float, *,
-                            cutoff: float = 400.0, angles: int = 512) -> complex:
+                            cutoff: float = 400.0, angles: int = 512,
+                            at: float | None = None) -> complex:
     """
-    Return the mean vertical displacement of a uniformly loaded square per newton (m/N).
+    Return the vertical displacement of a uniformly loaded square per newton (m/N).
 
     Parameters
     ----------
@@ -158,32 +176,38 @@ def square_patch_compliance(space: HalfSpace, frequency: float, side: float, *,
     frequency : float
         Hz; 0 gives the static settlement (Boussinesq, exact).
     side : float
-        Side b of the square (m).
+        Side b of the square (m), centred at the origin.
     cutoff : float
         Upper end of the wavenumber integral, in 1 / side (the static kernel
         is subtracted, so the remainder beyond it is of relative order
         (k_s side / cutoff)^2).
     angles : int
         Midpoints of the angular integral on a quarter turn.
+    at : float, optional
+        None: the mean over the square; x (m): the surface point (x, 0, 0).
 
     """
     if not side > 0:
         raise ValueError(f'the patch side must be > 0 m, not {side}')
     nu = space.poisson
+    if at is None:
+        shape = SQUARE_MEAN_SETTLEMENT / (2.0 * side)
+    else:
+        shape = _inverse_distance_integral(float(at), side) / (2.0 * math.pi * side**2)
     if frequency == 0.0:
-        return complex(SQUARE_MEAN_SETTLEMENT * (1.0 - nu) / (2.0 * space.shear_modulus * side))
+        return complex(shape * (1.0 - nu) / space.shear_modulus)
     if space.alpha == 0.0 and space.beta == 0.0:
         raise ValueError('the wavenumber integral runs along the real axis: it needs damping '
                          '(alpha or beta > 0) to keep the Rayleigh pole off it')
     omega = 2.0 * math.pi * frequency
     mu = space.complex_shear_modulus(omega)
-    static = SQUARE_MEAN_SETTLEMENT * (1.0 - nu) / (2.0 * mu * side)
+    static = shape * (1.0 - nu) / mu
     k_p, k_s = space.wavenumbers(omega)
     k_r = k_s.real / rayleigh_speed(nu)
 
     def remainder(k: float) -> complex:
         g = surface_kernel(space, omega, np.array([k]))[0] - (1.0 - nu) / (mu * k)
-        return complex(g * k * _patch_angular(k, side, angles))
+        return complex(g * k * _patch_angular(k, side, angles, at))
 
     top = cutoff / side
     points = sorted(p for p in (k_p.real, k_s.real, k_r, 1.2 * k_r, 2.0 * k_r) if p < top)
