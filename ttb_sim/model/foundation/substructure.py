@@ -244,11 +244,11 @@ def build(spec: Substructure, load: Optional[PileLoad] = None) -> PileSoilModel:
     lumped = hex8.lumped_mass(cut.coordinates, mats.density[tags.material])
     mass = np.bincount(np.repeat(cells.ravel(), 3) * 3 + np.tile(np.arange(3), cells.size),
                        weights=np.repeat(lumped.ravel(), 3), minlength=n_dofs)
-    enriched = spec.mesh.element == 'hex8i'
+    modes = spec.mesh.incompatible_modes
     k_soil, c_soil = _linear_operators(np.flatnonzero(tags.kind == SOIL), dofs, cut.coordinates,
-                                       tags.material, mats, lumped, n_dofs, enriched)
+                                       tags.material, mats, lumped, n_dofs, modes == 'all')
     k_str, c_str = _linear_operators(np.flatnonzero(tags.kind != SOIL), dofs, cut.coordinates,
-                                     tags.material, mats, lumped, n_dofs, enriched)
+                                     tags.material, mats, lumped, n_dofs, modes != 'none')
     structure_dofs = np.zeros(n_dofs, dtype=bool)
     structure_dofs[dofs[tags.kind != SOIL].ravel()] = True
     free, k_b, c_b = _boundary(spec, mesh, outer, cut.coordinates, mats, n_dofs)
@@ -318,7 +318,8 @@ def _linear_operators(sel: np.ndarray, dofs: np.ndarray, coords: np.ndarray,
     """
     Return the stiffness K and Rayleigh damping alpha M + beta K of the cells ``sel``.
 
-    ``incompatible``: bricks with Wilson's incompatible modes (``soil.mesh.element``).
+    ``incompatible``: bricks with Wilson's incompatible modes
+    (``soil.mesh.incompatible_modes``).
 
     K and beta K are assembled together, as the real and imaginary parts of one
     complex matrix, so that they share one pattern.
