@@ -68,7 +68,7 @@ def test_overrides_are_yaml_scalars():
     ('train=5', r'train = 5: train is a section, not a value; set one of its keys, e\.g\. '
      r'train\.speed_kmh \(its 12 keys: train\.vehicle, '),
     ('soil.mesh={h: 1}', r"soil.mesh = \{'h': 1\}: soil.mesh is a section, not a value; set one "
-     r'of its keys, e\.g\. soil\.mesh\.h \(its 6 keys'),
+     r'of its keys, e\.g\. soil\.mesh\.h \(its 7 keys'),
     ('output=', r"output = '': output is a section, not a value; .* 5 keys: output.rate_hz, "
      r'output.observers, output.soil_points, output.soil_grid_spacing, \.\.\.; see'),
 ])
