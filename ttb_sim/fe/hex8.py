@@ -216,7 +216,8 @@ def stiffness(coords: np.ndarray, young: np.ndarray, poisson: np.ndarray,
     if not incompatible:
         return k
     k_uu, k_ua, k_aa = k[:, :24, :24], k[:, :24, 24:], k[:, 24:, 24:]
-    return k_uu - np.matmul(k_ua, np.linalg.solve(k_aa, np.swapaxes(k_ua, 1, 2)))
+    condensed = k_uu - np.matmul(k_ua, np.linalg.solve(k_aa, np.swapaxes(k_ua, 1, 2)))
+    return 0.5 * (condensed + np.swapaxes(condensed, 1, 2))   # symmetric to the last bit
 
 
 def stiffness_reference(coords: np.ndarray, young: np.ndarray, poisson: np.ndarray,
