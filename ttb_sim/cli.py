@@ -144,6 +144,9 @@ def _add_model_verbs(sub: Any) -> None:
                     "pile head; master: the piled pier's ground seen from the cap's master "
                     '(6 x 6 dynamic stiffness), with the reduced substructure the time '
                     'stepping uses beside it')
+    fr.add_argument('--no-reduced', dest='reduced', action='store_false', help='with --at '
+                    'master: leave out the reduced substructure (its first build of a mesh '
+                    'takes minutes; a refinement study of the mesh does not need it)')
 
 
 def _add_bag_verbs(sub: Any) -> None:
@@ -370,7 +373,8 @@ def _main(argv: Sequence[str] | None) -> int:
             from ttb_sim.commands.frf import frf_command
             return frf_command(args.scenario, args.freqs, pml=args.pml, refine=args.refine,
                                solver=args.solver, overrides=args.overrides,
-                               json_path=args.json, plot_path=args.plot, at=args.at)
+                               json_path=args.json, plot_path=args.plot, at=args.at,
+                               reduced=args.reduced)
         if args.command == 'modes':
             from ttb_sim.commands.modes import modes_command
             return modes_command(args.scenario, around=args.around, count=args.count,

@@ -98,6 +98,7 @@ COARSE_PIER = ['--set', 'soil.block.lx=24', '--set', 'soil.block.ly=18', '--set'
 @pytest.mark.parametrize('args, match', [
     (['frf', 'live_coupled', '--at', 'pier'], "--at = 'pier': allowed values are load, master"),
     (['frf', 'single_pile', '--at', 'master'], 'no pile cap'),
+    (['frf', 'single_pile', '--no-reduced'], '--no-reduced: allowed only with --at master'),
 ])
 def test_master_refusals_exit_2_with_one_line(args: list[str], match: str,
                                               capsys: pytest.CaptureFixture[str]) -> None:
@@ -122,3 +123,13 @@ def test_at_master_sets_the_reduced_substructure_beside_the_unreduced_mesh(
     assert z.shape == (2, 6, 6) and np.abs(z[0].imag).max() == 0.0   # no damping at rest
     assert f'{abs(z[1, 2, 2]):12.4e}' in table
     assert png.stat().st_size > 10_000
+
+
+def test_at_master_without_the_reduced_substructure(tmp_path: Path) -> None:
+    """--no-reduced: the meshes alone (no reduction is built), the halved one the reference."""
+    out = tmp_path / 'master.json'
+    assert main(['frf', 'live_coupled', '--at', 'master', '--freqs', '0,2', '--refine',
+                 '--no-reduced', '--json', str(out), *COARSE_PIER]) == 0
+    report = json.loads(out.read_text())
+    assert [c['label'] for c in report['cases']] == ['scenario', 'halved']
+    assert report['reference'] == 'halved'

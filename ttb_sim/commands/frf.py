@@ -159,7 +159,8 @@ def _pier_load(loaded: Any) -> Any:
 
 def frf_report(scenario: str | Path, freqs: Sequence[float], *, pml: Optional[float] = None,
                refine: bool = False, solver: str = 'auto',
-               overrides: Sequence[str] = (), at: str = 'load') -> dict[str, Any]:
+               overrides: Sequence[str] = (), at: str = 'load',
+               reduced: bool = True) -> dict[str, Any]:
     """
     Return the receptances of a substructure scenario (and of its halved mesh).
 
@@ -171,7 +172,8 @@ def frf_report(scenario: str | Path, freqs: Sequence[float], *, pml: Optional[fl
         'halved'), each with 'dofs', 'unknowns', 'solver', 'symmetry', 'seconds'
         and complex receptances (m/N) 'head' (the loaded pile, along the load)
         and 'points' (name -> receptance along the load). With ``at='master'``
-        the report of :func:`~.frf_master.master_report` instead.
+        the report of :func:`~.frf_master.master_report` instead, with the reduced
+        substructure beside the meshes unless ``reduced`` is False.
 
     """
     _check_options(pml, solver, ())
@@ -189,7 +191,7 @@ def frf_report(scenario: str | Path, freqs: Sequence[float], *, pml: Optional[fl
         check_master_scenario(loaded)
         return master_report(loaded, spec, values, pml=pml, refine=refine, solver=solver,
                              progress=lambda label: _progress(label, len(values)),
-                             halved=_halved)
+                             halved=_halved, reduced=reduced)
     load = loaded.load if loaded.substructure_only else _pier_load(loaded)
     cases = [_case(spec, load, values, pml, solver, 'scenario')]
     if refine:
@@ -276,14 +278,17 @@ def plot_frf(report: dict[str, Any], path: Path) -> Path:
 def frf_command(scenario: str, freqs: str, *, pml: Optional[float] = None,
                 refine: bool = False, solver: str = 'auto', overrides: Sequence[str] = (),
                 json_path: Optional[Path] = None, plot_path: Optional[Path] = None,
-                at: str = 'load') -> int:
+                at: str = 'load', reduced: bool = True) -> int:
     """Run ``ttb-sim frf``: print the table (and write JSON and a figure); return 0."""
     values = parse_frequencies(freqs)
     _check_options(pml, solver, (json_path, plot_path))
     if at not in AT:
         raise ScenarioError(f'--at = {shown(at)}: allowed values are ' + ', '.join(AT))
+    if not reduced and at != 'master':
+        raise ScenarioError('--no-reduced: allowed only with --at master (the reduced '
+                            'substructure is shown there alone)')
     report = frf_report(scenario, values, pml=pml, refine=refine, solver=solver,
-                        overrides=overrides, at=at)
+                        overrides=overrides, at=at, reduced=reduced)
     if at == 'master':
         from ttb_sim.commands.frf_master import format_master, jsonable_master, plot_master
 

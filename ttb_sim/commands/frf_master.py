@@ -40,13 +40,15 @@ SHOWN = (('Z_uz', 2), ('Z_ux', 0), ('Z_ry', 4))
 
 
 def master_report(loaded: Any, spec: Any, values: list[float], *, pml: Optional[float],
-                  refine: bool, solver: str, progress: Any, halved: Any) -> dict[str, Any]:
+                  refine: bool, solver: str, progress: Any, halved: Any,
+                  reduced: bool = True) -> dict[str, Any]:
     """
     Return the master impedances of every case and their differences from the finest.
 
     ``loaded`` is the scenario, ``spec`` its piled piers' substructure,
     ``progress(label)`` a solve's progress callback, ``halved(spec)`` the
-    spec with every element size halved.
+    spec with every element size halved; ``reduced`` False leaves the reduced
+    substructure out.
     """
     from ttb_sim.model.foundation.frequency_response import MatchedLayer
     from ttb_sim.model.foundation.master_response import (master_errors, master_response,
@@ -59,9 +61,9 @@ def master_report(loaded: Any, spec: Any, values: list[float], *, pml: Optional[
         r = master_response(s, values, layer=layer, method=solver, progress=progress(label))
         cases.append((label, r, f'unknowns per symmetry class {list(r.unknowns)}, '
                       f'{r.method}, {sum(r.seconds):.1f} s'))
-    reduced = _reduced_response(loaded, values)
-    if reduced is not None:
-        cases.append(('reduced', reduced, f'{reduced.unknowns[0]} coordinates (the time '
+    block = _reduced_response(loaded, values) if reduced else None
+    if block is not None:
+        cases.append(('reduced', block, f'{block.unknowns[0]} coordinates (the time '
                       "stepping's substructure, the scenario's mesh and boundary)"))
     reference = cases[len(specs) - 1]
     out = []
