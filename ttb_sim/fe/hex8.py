@@ -157,6 +157,20 @@ def _incompatible_physical(coords: np.ndarray, det: np.ndarray) -> np.ndarray:
     return grad * (det0[:, None] / det)[:, :, None, None]
 
 
+def _gradients(coords: np.ndarray, stretch: Optional[np.ndarray], incompatible: bool
+               ) -> tuple[np.ndarray, np.ndarray]:
+    """
+    Return the functions' gradients (m, 8g, n, 3) and volume factors (m, 8g) of the bricks.
+
+    n = 8 nodal functions, 11 with the incompatible modes; stretched when given.
+    """
+    coords = np.asarray(coords, dtype=float)
+    grad, det = _jacobians(coords)
+    if incompatible:
+        grad = np.concatenate([grad, _incompatible_physical(coords, det)], axis=2)
+    return stretched(grad, det, stretch)
+
+
 def _elastic_form(grad: np.ndarray, det: np.ndarray, young: np.ndarray,
                   poisson: np.ndarray) -> np.ndarray:
     """
@@ -206,12 +220,7 @@ def stiffness(coords: np.ndarray, young: np.ndarray, poisson: np.ndarray,
         Shape (m, 24, 24), N/m; complex (and complex symmetric) with a stretch.
 
     """
-    coords = np.asarray(coords, dtype=float)
-    grad, det = _jacobians(coords)
-    if incompatible:
-        extra = _incompatible_physical(coords, det)
-        grad = np.concatenate([grad, extra], axis=2)
-    grad, det = stretched(grad, det, stretch)
+    grad, det = _gradients(coords, stretch, incompatible)
     k = _elastic_form(grad, det, young, poisson)
     if not incompatible:
         return k
@@ -229,11 +238,7 @@ def stiffness_reference(coords: np.ndarray, young: np.ndarray, poisson: np.ndarr
     With ``incompatible``, B has the nine incompatible modes' columns too and
     they are condensed out by an explicit inverse of their block.
     """
-    coords = np.asarray(coords, dtype=float)
-    grad, det = _jacobians(coords)
-    if incompatible:
-        grad = np.concatenate([grad, _incompatible_physical(coords, det)], axis=2)
-    grad, det = stretched(grad, det, stretch)
+    grad, det = _gradients(coords, stretch, incompatible)
     b = strain_matrices(grad)
     d = elasticity(young, poisson)
     db = np.matmul(d[:, None], b)

@@ -227,8 +227,7 @@ class DynamicStiffness:
             self._dofs = node_dofs(model.mesh.cells)[sel]
             self._elastic = (mats.young[mat], mats.poisson[mat], mats.density[mat])
             self._rayleigh = (mats.alpha[mat], mats.beta[mat])
-            # the layer's cells are soil: enriched only with incompatible_modes 'all'
-            self._enriched = model.spec.mesh.incompatible_modes == 'all'
+            self._enriched = model.spec.mesh.enriches(soil=True)   # the layer's cells are soil
             self._gauss = np.einsum('ga,eai->egi', hex8.shape_functions(hex8.GAUSS_POINTS),
                                     self._coords)
             # the same cells unstretched, once: Z_plain(w) = (1 + i w beta) K + (i w alpha - w^2) M

@@ -153,6 +153,11 @@ class MeshSize:
         """Largest vertical element size along the piles (m)."""
         return self.h_shaft if self.h_shaft > 0 else min(self.h_max, 4 * self.h)
 
+    def enriches(self, soil: bool) -> bool:
+        """Tell whether soil bricks (True) or pile and cap bricks (False) get the modes."""
+        return self.incompatible_modes == 'all' or (
+            not soil and self.incompatible_modes == 'structure')
+
 
 @dataclass(frozen=True)
 class ReductionParameters:

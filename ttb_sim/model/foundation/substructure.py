@@ -244,11 +244,12 @@ def build(spec: Substructure, load: Optional[PileLoad] = None) -> PileSoilModel:
     lumped = hex8.lumped_mass(cut.coordinates, mats.density[tags.material])
     mass = np.bincount(np.repeat(cells.ravel(), 3) * 3 + np.tile(np.arange(3), cells.size),
                        weights=np.repeat(lumped.ravel(), 3), minlength=n_dofs)
-    modes = spec.mesh.incompatible_modes
     k_soil, c_soil = _linear_operators(np.flatnonzero(tags.kind == SOIL), dofs, cut.coordinates,
-                                       tags.material, mats, lumped, n_dofs, modes == 'all')
+                                       tags.material, mats, lumped, n_dofs,
+                                       spec.mesh.enriches(soil=True))
     k_str, c_str = _linear_operators(np.flatnonzero(tags.kind != SOIL), dofs, cut.coordinates,
-                                     tags.material, mats, lumped, n_dofs, modes != 'none')
+                                     tags.material, mats, lumped, n_dofs,
+                                     spec.mesh.enriches(soil=False))
     structure_dofs = np.zeros(n_dofs, dtype=bool)
     structure_dofs[dofs[tags.kind != SOIL].ravel()] = True
     free, k_b, c_b = _boundary(spec, mesh, outer, cut.coordinates, mats, n_dofs)

@@ -49,6 +49,7 @@ import math
 
 import numpy as np
 from scipy.integrate import quad
+from scipy.optimize import brentq
 
 SQUARE_MEAN_SETTLEMENT = 4.0 / math.pi * (math.log(1.0 + math.sqrt(2.0))
                                           - (math.sqrt(2.0) - 1.0) / 3.0)
@@ -106,9 +107,8 @@ class HalfSpace:
         """Return (k_p, k_s), complex with damping (imaginary parts <= 0)."""
         mu = self.complex_shear_modulus(omega)
         rho = self.density * (1.0 - 1j * self.alpha / omega)
-        ratio = (1.0 - 2.0 * self.poisson) / (2.0 * (1.0 - self.poisson))   # (Vs / Vp)^2
         k_s = np.sqrt(omega**2 * rho / mu)
-        return complex(k_s * math.sqrt(ratio)), complex(k_s)
+        return complex(k_s * math.sqrt(speed_ratio_squared(self.poisson))), complex(k_s)
 
 
 def surface_kernel(space: HalfSpace, omega: float, k: np.ndarray) -> np.ndarray:
@@ -121,21 +121,20 @@ def surface_kernel(space: HalfSpace, omega: float, k: np.ndarray) -> np.ndarray:
     return -k_s * k_s * nu_p / (space.complex_shear_modulus(omega) * rayleigh)
 
 
+def speed_ratio_squared(poisson: float) -> float:
+    """Return (Vs / Vp)^2 = (1 - 2 nu) / (2 (1 - nu))."""
+    return (1.0 - 2.0 * poisson) / (2.0 * (1.0 - poisson))
+
+
 def rayleigh_speed(poisson: float) -> float:
-    """Return the Rayleigh-wave speed over Vs of an elastic half-space (root of F)."""
-    ratio = (1.0 - 2.0 * poisson) / (2.0 * (1.0 - poisson))
-    lo, hi = 0.5, 1.0 - 1e-12
+    """Return the Rayleigh-wave speed over Vs of an elastic half-space (root of F, Brent)."""
+    ratio = speed_ratio_squared(poisson)
 
     def rayleigh(c: float) -> float:
         return (2.0 - c * c)**2 - 4.0 * math.sqrt(1.0 - ratio * c * c) * math.sqrt(1.0 - c * c)
 
-    for _ in range(200):
-        mid = 0.5 * (lo + hi)
-        if rayleigh(lo) * rayleigh(mid) <= 0:
-            hi = mid
-        else:
-            lo = mid
-    return 0.5 * (lo + hi)
+    # F > 0 at c = 0.5 and < 0 just below 1 for every 0 <= nu < 0.5: one root between
+    return float(brentq(rayleigh, 0.5, 1.0 - 1e-12, xtol=1e-15, rtol=1e-15))
 
 
 def _patch_angular(k: float, side: float, n: int, x: float | None = None) -> float:
