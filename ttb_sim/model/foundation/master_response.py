@@ -37,16 +37,16 @@ from dataclasses import dataclass, field
 import logging
 import math
 import time
-from typing import Callable, Literal, Optional, Sequence
+from typing import Callable, Optional, Sequence
 
 import numpy as np
 import scipy.sparse as sp
 
-from ttb_sim.errors import FEError
 from ttb_sim.fe.complex_solve import factorize_complex
-from ttb_sim.fe.symmetry import has_parity, mirror_nodes, mirror_reduction, MirrorPlane
+from ttb_sim.fe.symmetry import MirrorPlane
 from ttb_sim.model.foundation.frequency_response import (DynamicStiffness, MatchedLayer,
                                                          SymmetryChoice, with_matched_layer)
+from ttb_sim.model.foundation.mirror_classes import class_coordinates, symmetry_classes
 from ttb_sim.model.foundation.records import FoundationError, Substructure
 from ttb_sim.model.foundation.substructure import build, PileSoilModel
 from ttb_sim.model.foundation.tied import cap_tie
@@ -106,38 +106,6 @@ class MasterResponse:
         return np.einsum('fpaj,fjk->fpak', self.points, self.impedance())
 
 
-def symmetry_classes(model: PileSoilModel, transform: sp.csr_matrix
-                     ) -> list[tuple[tuple[int, ...], tuple[MirrorPlane, ...]]]:
-    """
-    Group the master components by their mirror parities: [(components, planes)].
-
-    A component's unit motion (a column of the tie ``transform``) is a nodal
-    field; a plane of the mesh's symmetry is used for the class when that field
-    has one of its two parities there.
-    """
-    mesh = model.mesh
-    images: dict[Literal['x', 'y'], np.ndarray] = {}
-    if not model.spec.soil.periodic:
-        axes: tuple[Literal['x', 'y'], ...] = ('x', 'y')
-        for axis in axes:
-            try:
-                images[axis] = mirror_nodes(mesh.nodes, mesh.cells, mesh.material, axis)
-            except FEError as exc:  # not a symmetric mesh
-                log.debug('no mirror about %s = 0: %s', axis, exc)
-    groups: dict[tuple[MirrorPlane, ...], list[int]] = {}
-    for j in range(6):
-        motion = transform[:, j].toarray().ravel()
-        planes = []
-        for axis, image in images.items():
-            for parity in ('symmetric', 'antisymmetric'):
-                plane = MirrorPlane(axis, parity)
-                if has_parity(motion, image, plane):
-                    planes.append(plane)
-                    break
-        groups.setdefault(tuple(planes), []).append(j)
-    return [(tuple(comps), planes) for planes, comps in groups.items()]
-
-
 def class_basis(model: PileSoilModel, transform: sp.csr_matrix, kept: np.ndarray,
                 components: Sequence[int], planes: tuple[MirrorPlane, ...]) -> sp.csr_matrix:
     """
@@ -145,15 +113,7 @@ def class_basis(model: PileSoilModel, transform: sp.csr_matrix, kept: np.ndarray
 
     The interior part is the mirror reduction of the tie's free DOFs off the cap top.
     """
-    mesh = model.mesh
-    if planes:
-        t = mirror_reduction(mesh.nodes, mesh.cells, mesh.material, planes)[kept].tocsc()
-        t = t[:, np.flatnonzero(np.diff(t.indptr) > 0)]
-    else:
-        t = sp.identity(len(kept), format='csc')
-    k = len(components)
-    pick = sp.csr_matrix((np.ones(k), (np.asarray(components), np.arange(k))), shape=(6, k))
-    return (transform @ sp.block_diag([pick, t])).tocsr()
+    return (transform @ class_coordinates(model, kept, components, planes)).tocsr()
 
 
 def master_response(spec: Substructure, frequencies: Sequence[float], *,

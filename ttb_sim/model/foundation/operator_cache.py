@@ -43,7 +43,7 @@ from ttb_sim.model.foundation.records import FoundationError, ReductionParameter
 
 LOG = logging.getLogger(__name__)
 
-FORMAT = 3
+FORMAT = 4
 """Version of the reduction and of its cache files; part of the cache key."""
 
 

@@ -37,7 +37,11 @@ The reduced-order pier-cap-pile-soil substructure of one piled pier.
    ``shift_axis='imaginary'`` the shift is s = i w: Z = K - w^2 M + i w C,
    complex symmetric, solved through the LDL^T factors of its real 2n form,
    and the real and imaginary parts of the vectors enter the basis; exact at
-   w, but far dearer to factorise.) The vectors
+   w, but far dearer to factorise.) A group centred in a mirror-symmetric
+   block splits the master loads into symmetry classes (uz; ux, ry; uy, rx;
+   rz), each factorised and recurred on its own quarter of the unknowns
+   (:func:`~.krylov.mirror_parts`; exact, and about a sixteenth of the work of
+   a factorisation of the whole each). The vectors
    of all shifts, less their master part (so that V vanishes on the master),
    are mass-orthonormalised with deflation. The damping is projected, not
    diagonalised (the boundary dashpots make it far from proportional). The
