@@ -92,14 +92,16 @@ from ttb_sim.model.foundation.tied import check_spec, tie_cap, TiedSubstructure
 
 LOG = logging.getLogger(__name__)
 
-SHIFT_SECONDS = 3.3
-"""CPU seconds of one shift (a CHOLMOD factorisation and its Krylov solves) at
-:data:`SHIFT_DOFS` DOFs, measured on this 2-core machine (the live mesh: 18 144 DOFs, 6.7-8.1 s
-for two shifts)."""
+SHIFT_SECONDS = 1.2
+"""CPU seconds of one shift (the CHOLMOD factorisations of the four symmetry classes and their
+Krylov solves) at :data:`SHIFT_DOFS` DOFs, measured on this 2-core machine (the live mesh:
+17 478 tied DOFs, 2.0-2.9 s for two shifts; a mesh without mirror symmetry costs about three
+times as much)."""
 SHIFT_DOFS = 18_000
-SHIFT_EXPONENT = 2.3
-"""Growth of a shift's cost with the DOFs of a 3-D mesh (measured: 3.2 s at 17 478 factorised
-unknowns, 11 s at 28 290, about 100 s at the paper mesh's 81 648)."""
+SHIFT_EXPONENT = 2.05
+"""Growth of a shift's cost with the DOFs of a 3-D mesh (measured: 1.0-1.45 s a shift at 17 478
+tied DOFs, 27 s at the paper mesh's 79 887; imaginary shifts with PARDISO cost about a quarter
+of this estimate: 65 s a shift at 257 070 DOFs)."""
 
 
 def build_seconds(dofs: int, shifts: int) -> float:
