@@ -21,16 +21,23 @@ import pytest
 import scipy.sparse as sp
 
 from ttb_sim.errors import FEError
-from ttb_sim.fe.complex_solve import factorize_complex, pardiso_available
+from ttb_sim.fe.complex_solve import (factorize_complex, factorize_positive_definite,
+                                      pardiso_available)
 
 
-def dynamic_stiffness(n: int = 300, seed: int = 3) -> sp.csr_matrix:
-    """Return K - w^2 M + i w C of a damped chain: complex symmetric, indefinite real part."""
+def dynamic_stiffness(n: int = 300, seed: int = 3, w_zero: bool = False) -> sp.csr_matrix:
+    """
+    Return K - w^2 M + i w C of a damped chain: complex symmetric, indefinite real part.
+
+    ``w_zero``: K alone, real symmetric positive definite.
+    """
     rng = np.random.default_rng(seed)
     k = sp.diags([-np.ones(n - 1), 2.0 * np.ones(n), -np.ones(n - 1)], [-1, 0, 1]) * 1e3
     k = k + sp.diags(rng.uniform(0, 10, n))
     m = sp.diags(rng.uniform(0.5, 1.5, n))
     c = 0.02 * k + 0.1 * m
+    if w_zero:
+        return k.tocsr()
     w = 30.0   # above the lowest natural frequencies: K - w^2 M is indefinite
     return (k - w * w * m + 1j * w * c).tocsr()
 
@@ -67,3 +74,27 @@ def test_refusals() -> None:
         factorize_complex(z + sp.csr_matrix(([1.0], ([0], [5])), shape=z.shape))
     with pytest.raises(FEError, match='square'):
         factorize_complex(sp.csr_matrix((3, 4)))
+
+
+NEEDS_PARDISO = pytest.mark.skipif(not pardiso_available(), reason='MKL PARDISO not installed '
+                                   "(pip install 'ttb_sim[pardiso]'); the reduction's positive "
+                                   'definite pencils go to CHOLMOD without it')
+
+
+@NEEDS_PARDISO
+def test_positive_definite_factor_matches_dense_numpy_and_repeats() -> None:
+    """The Cholesky of PARDISO (type 2) of a stiffness-like SPD matrix: round-off, same bits."""
+    z = dynamic_stiffness(w_zero=True)
+    rhs = np.random.default_rng(1).normal(size=(z.shape[0], 3))
+    x = factorize_positive_definite(z).solve(rhs)
+    exact = np.linalg.solve(z.toarray(), rhs)
+    assert x.dtype == np.float64
+    assert np.abs(x - exact).max() < 1e-10 * np.abs(exact).max()
+    assert np.array_equal(x, factorize_positive_definite(z).solve(rhs))
+
+
+@NEEDS_PARDISO
+def test_positive_definite_factor_refuses_an_indefinite_matrix() -> None:
+    k = sp.diags([1.0, -1.0, 2.0]).tocsr()
+    with pytest.raises(FEError, match='not positive definite'):
+        factorize_positive_definite(k)

@@ -55,6 +55,8 @@ METHODS = ('auto', 'pardiso', 'superlu')
 
 _COMPLEX_SYMMETRIC = 6
 """PARDISO's matrix type of a complex symmetric matrix."""
+_REAL_POSITIVE_DEFINITE = 2
+"""PARDISO's matrix type of a real symmetric positive definite matrix (Cholesky)."""
 
 
 class ComplexFactorization(Protocol):
@@ -99,33 +101,42 @@ def resolve_method(method: str) -> str:
 
 
 class _Pardiso:
-    """A PARDISO LDL^T factor of a complex symmetric matrix (freed with the object)."""
+    """
+    A PARDISO factor of a symmetric matrix (freed with the object).
+
+    ``matrix_type`` 6: complex symmetric (LDL^T, Bunch-Kaufman pivots); 2: real
+    symmetric positive definite (Cholesky), for :func:`factorize_positive_definite`.
+    """
 
     method = 'pardiso'
 
-    def __init__(self, matrix: sp.csr_matrix) -> None:
+    def __init__(self, matrix: sp.csr_matrix, matrix_type: int = _COMPLEX_SYMMETRIC) -> None:
         self._mkl, self._solvers = _pardiso_module()
-        upper = sp.triu(matrix, format='csr').astype(np.complex128)
+        self._type = matrix_type
+        self._dtype = np.complex128 if matrix_type == _COMPLEX_SYMMETRIC else np.float64
+        upper = sp.triu(matrix, format='csr').astype(self._dtype)
         upper.sort_indices()
         self._upper = upper
-        self._pt, self._iparm = self._solvers.pardisoinit(_COMPLEX_SYMMETRIC)
-        self._run(np.zeros((matrix.shape[0], 1), dtype=np.complex128), phase=12)
+        self._pt, self._iparm = self._solvers.pardisoinit(matrix_type)
+        self._run(np.zeros((matrix.shape[0], 1), dtype=self._dtype), phase=12)
 
     def _run(self, rhs: np.ndarray, phase: int) -> np.ndarray:
         previous = self._mkl.mkl_set_num_threads_local(1)   # one thread: the same bits
         try:
             x, self._pt, _, error = self._solvers.pardiso(
-                self._upper, rhs, self._pt, _COMPLEX_SYMMETRIC, self._iparm, phase=phase,
+                self._upper, rhs, self._pt, self._type, self._iparm, phase=phase,
                 quiet=True)
         finally:
             self._mkl.mkl_set_num_threads_local(previous)
         if error != 0:
-            raise FEError(f'PARDISO failed with error {error} (phase {phase}): the dynamic '
-                          'stiffness is singular or the memory ran out')
+            what = ('the dynamic stiffness is singular' if self._type == _COMPLEX_SYMMETRIC
+                    else 'the matrix is not positive definite')
+            raise FEError(f'PARDISO failed with error {error} (phase {phase}): {what} or the '
+                          'memory ran out')
         return np.asarray(x)
 
     def solve(self, rhs: np.ndarray) -> np.ndarray:
-        b = np.asarray(rhs, dtype=np.complex128)
+        b = np.asarray(rhs, dtype=self._dtype)
         column = b.ndim == 1
         b = b.reshape(len(b), -1)
         # one right-hand side per call: the wrapper takes C-ordered arrays, PARDISO reads
@@ -136,9 +147,30 @@ class _Pardiso:
 
     def __del__(self) -> None:
         try:
-            self._run(np.zeros((self._upper.shape[0], 1), dtype=np.complex128), phase=-1)
+            self._run(np.zeros((self._upper.shape[0], 1), dtype=self._dtype), phase=-1)
         except Exception:  # interpreter shutdown, or never factorised
             pass
+
+
+def factorize_positive_definite(matrix: sp.spmatrix | sp.sparray) -> _Pardiso:
+    """
+    Return MKL PARDISO's Cholesky factor of a real symmetric positive definite matrix.
+
+    One thread, nested-dissection order. The large 3-D meshes' alternative
+    to CHOLMOD through the ``cholespy`` wheel, whose bundled reference BLAS
+    makes its supernodes slow: measured on a 61 k-unknown class of a 0.5 m
+    pile-soil block, 4.1 s against 58 s of CPU. Needs the ``pardiso`` extra
+    (:func:`pardiso_available`).
+
+    Raises
+    ------
+    FEError
+        PARDISO is not installed, or the factorisation failed.
+
+    """
+    if not pardiso_available():
+        raise FEError("a PARDISO Cholesky needs MKL PARDISO: pip install 'ttb_sim[pardiso]'")
+    return _Pardiso(sp.csr_matrix(matrix), _REAL_POSITIVE_DEFINITE)
 
 
 class _SuperLU:

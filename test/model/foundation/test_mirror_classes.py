@@ -21,6 +21,7 @@ import numpy as np
 import pytest
 import scipy.sparse as sp
 
+from ttb_sim.fe.complex_solve import pardiso_available
 from ttb_sim.model.foundation import krylov
 from ttb_sim.model.foundation.mirror_classes import class_coordinates, invariant
 from ttb_sim.model.foundation.records import (BlockSize, Cap, MeshSize, Observation, PileGroup,
@@ -115,3 +116,19 @@ def test_class_coordinates_pick_the_components_and_tie_mirror_pairs(tied):
     p = class_coordinates(tied.model, kept, (2,), ())
     assert p.shape == (tied.size, 1 + len(kept))
     assert p[2, 0] == 1.0 and p[:6, 0].sum() == 1.0
+
+
+@pytest.mark.skipif(not pardiso_available(), reason='MKL PARDISO not installed (pip install '
+                    'ttb_sim[pardiso]): the positive definite pencils go to CHOLMOD alone')
+def test_pardiso_and_cholmod_pencils_give_the_same_reduced_response(tied, monkeypatch):
+    """The two Cholesky factorisations of the static and real-shift pencils agree to 1e-8."""
+    reduction = ReductionParameters(shifts=(0.0, 10.0), levels=3)
+    assert krylov.positive_definite_method() == 'pardiso'
+    psi, v = krylov.reduction_basis(tied, reduction)
+    monkeypatch.setattr(krylov, 'pardiso_available', lambda: False)
+    assert krylov.positive_definite_method() == 'cholmod'
+    psi_c, v_c = krylov.reduction_basis(tied, reduction)
+    freqs = [0.0, 3.0, 7.0, 15.0]
+    got, want = _flexibility(tied, psi, v, freqs), _flexibility(tied, psi_c, v_c, freqs)
+    scale = np.abs(want).max(axis=(1, 2))
+    assert (np.abs(got - want).max(axis=(1, 2)) < 1e-8 * scale).all()

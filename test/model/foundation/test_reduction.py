@@ -303,3 +303,4 @@ def test_progress_is_a_warning_only_for_a_long_build():
     assert red.BuildProgress(2, red.build_seconds(18_144, 2)).level == logging.INFO
     paper, live = red.build_seconds(81_648, 5), red.build_seconds(18_144, 2)
     assert 60 < paper < 300 and 1 < live < 6   # measured by symmetry classes: 133 s, 2.0-2.9 s
+    assert red.build_seconds(81_648, 5, pardiso=True) == pytest.approx(paper / 3.4)

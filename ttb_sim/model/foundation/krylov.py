@@ -40,8 +40,9 @@ import numpy as np
 import scipy.linalg as sla
 import scipy.sparse as sp
 
-from ttb_sim.fe.complex_solve import factorize_complex, resolve_method
-from ttb_sim.fe.factorization import available, factorize
+from ttb_sim.fe.complex_solve import (factorize_complex, factorize_positive_definite,
+                                      pardiso_available, resolve_method)
+from ttb_sim.fe.factorization import available, factorize, resolve
 from ttb_sim.model.foundation.mirror_classes import (class_coordinates, invariant,
                                                      symmetry_classes)
 from ttb_sim.model.foundation.records import ReductionParameters
@@ -49,11 +50,29 @@ from ttb_sim.model.foundation.tied import TiedSubstructure
 
 LOG = logging.getLogger(__name__)
 
-FACTORIZATION = 'cholmod'
-"""Factorisation of the shifted pencils (falls back as :func:`factorize` says)."""
-
-
 Solve = Callable[[np.ndarray], np.ndarray]
+
+FACTORIZATION = 'cholmod'
+"""Factorisation of the positive definite pencils (the static stiffness and the real shifts)
+without MKL PARDISO (falls back as :func:`factorize` says)."""
+
+
+def positive_definite_method() -> str:
+    """
+    Return the factorisation of the positive definite pencils: ``pardiso`` or FACTORIZATION's.
+
+    PARDISO's Cholesky when the ``pardiso`` extra is installed: 14 times faster
+    than CHOLMOD on a 61 k-unknown class of a 0.5 m block
+    (:func:`~ttb_sim.fe.complex_solve.factorize_positive_definite`).
+    """
+    return 'pardiso' if pardiso_available() else resolve(FACTORIZATION)
+
+
+def _positive_definite_solve(a: sp.csr_matrix) -> Solve:
+    """Return a solve of the symmetric positive definite a (:func:`positive_definite_method`)."""
+    if positive_definite_method() == 'pardiso':
+        return factorize_positive_definite(a).solve
+    return factorize(a, method=FACTORIZATION).solve
 
 
 @dataclass(frozen=True)
@@ -94,7 +113,7 @@ def reduction_basis(tied: TiedSubstructure, reduction: ReductionParameters,
     x0 = np.empty((n, 6))
     blocks: list[np.ndarray] = []
     for part in parts:  # one factorisation in memory at a time
-        static = part.lifted(factorize(part.restricted(k), method=FACTORIZATION).solve)
+        static = part.lifted(_positive_definite_solve(part.restricted(k)))
         cols = list(part.components)
         x0[:, cols] = static(b[:, cols])
         if 0.0 in reduction.shifts:
@@ -157,7 +176,7 @@ def _shift_blocks(tied: TiedSubstructure, part: _Part, w: float,
     cols = list(part.components)
     if reduction.shift_axis == 'real':
         pencil = part.restricted(_symmetric(k + w * c + (w * w) * m))
-        solve = part.lifted(factorize(pencil, method=FACTORIZATION).solve)
+        solve = part.lifted(_positive_definite_solve(pencil))
         return _soar(solve, (c + 2 * w * m).tocsr(), m, weight, b[:, cols],
                      reduction.levels, reduction.tolerance)
     solve = part.lifted(_complex_solver(part.restricted(k), part.restricted(c),

@@ -36,8 +36,7 @@ import scipy
 
 from ttb_sim.fe.beam import BeamSection
 from ttb_sim.fe.complex_solve import resolve_method
-from ttb_sim.fe.factorization import resolve
-from ttb_sim.model.foundation.krylov import FACTORIZATION
+from ttb_sim.model.foundation.krylov import positive_definite_method
 from ttb_sim.model.foundation.operator import FoundationOperator, InterfaceRows
 from ttb_sim.model.foundation.records import FoundationError, ReductionParameters, Substructure
 
@@ -58,7 +57,7 @@ def cache_key(spec: Substructure, pier_height: float, pier_elements: int,
               reduction: ReductionParameters) -> str:
     """Return the SHA-256 of every input of :func:`pile_soil_operator` (and the code)."""
     digest = hashlib.sha256()
-    text = repr((FORMAT, resolve(FACTORIZATION), np.__version__, scipy.__version__, spec,
+    text = repr((FORMAT, positive_definite_method(), np.__version__, scipy.__version__, spec,
                  float(pier_height), int(pier_elements),
                  tuple(float(v) for v in pier_rayleigh), reduction))
     if reduction.shift_axis == 'imaginary':   # the complex pencils' solver (PARDISO or not)
