@@ -51,7 +51,7 @@ def tied():
 
 
 def _whole(tied):
-    return [krylov._Part(tuple(range(6)), sp.identity(tied.size, format='csr'))]
+    return [krylov.MirrorPart(tuple(range(6)), sp.identity(tied.size, format='csr'))]
 
 
 def _flexibility(tied, psi, v, freqs):

@@ -76,7 +76,7 @@ def _positive_definite_solve(a: sp.csr_matrix) -> Solve:
 
 
 @dataclass(frozen=True)
-class _Part:
+class MirrorPart:
     """One mirror-symmetry class of the master: its components and coordinates P."""
 
     components: tuple[int, ...]
@@ -144,7 +144,7 @@ def reduction_basis(tied: TiedSubstructure, reduction: ReductionParameters,
     return psi, _orthonormal(interior, weight[6:], reduction.tolerance)
 
 
-def mirror_parts(tied: TiedSubstructure) -> list[_Part]:
+def mirror_parts(tied: TiedSubstructure) -> list[MirrorPart]:
     """
     Return the master's mirror-symmetry classes that K, C and M keep apart.
 
@@ -155,8 +155,8 @@ def mirror_parts(tied: TiedSubstructure) -> list[_Part]:
     """
     model = tied.model
     kept = tied.transform[:, 6:].tocsc().indices
-    whole = [_Part(tuple(range(6)), sp.identity(tied.size, format='csr'))]
-    parts = [_Part(comps, class_coordinates(model, kept, comps, planes))
+    whole = [MirrorPart(tuple(range(6)), sp.identity(tied.size, format='csr'))]
+    parts = [MirrorPart(comps, class_coordinates(model, kept, comps, planes))
              for comps, planes in symmetry_classes(model, tied.transform)]
     if len(parts) == 1:
         return whole
@@ -168,7 +168,7 @@ def mirror_parts(tied: TiedSubstructure) -> list[_Part]:
     return parts
 
 
-def _shift_blocks(tied: TiedSubstructure, part: _Part, w: float,
+def _shift_blocks(tied: TiedSubstructure, part: MirrorPart, w: float,
                   reduction: ReductionParameters, weight: np.ndarray,
                   b: np.ndarray) -> list[np.ndarray]:
     """Return one class's Krylov blocks at the shift w (rad/s) on ``reduction``'s axis."""
