@@ -28,7 +28,7 @@ from ttb_sim.model.foundation.records import (BlockSize, Cap, MeshSize, Observat
                                               ReductionParameters, SoilLayer, SoilParameters,
                                               Substructure)
 from ttb_sim.model.foundation.substructure import build
-from ttb_sim.model.foundation.tied import tie_cap
+from ttb_sim.model.foundation.tied import cap_tie, tie_cap
 
 LAYERS = (SoilLayer(2.0, 4e6, 0.35, 1835.0, 20e3, 5.0),
           SoilLayer(6.0, 6e6, 0.25, 1529.0, 10e3, 30.0))
@@ -51,7 +51,8 @@ def tied():
 
 
 def _whole(tied):
-    return [krylov.MirrorPart(tuple(range(6)), sp.identity(tied.size, format='csr'))]
+    return [krylov.MirrorPart(tuple(range(6)), sp.identity(tied.size, format='csr'),
+                              tied.stiffness, tied.damping, tied.mass)]
 
 
 def _flexibility(tied, psi, v, freqs):
@@ -112,9 +113,9 @@ def test_a_group_off_centre_in_x_splits_about_y_only():
 
 
 def test_class_coordinates_pick_the_components_and_tie_mirror_pairs(tied):
-    kept = tied.transform[:, 6:].tocsc().indices
-    p = class_coordinates(tied.model, kept, (2,), ())
-    assert p.shape == (tied.size, 1 + len(kept))
+    assert np.array_equal(tied.kept, cap_tie(tied.model)[1])
+    p = class_coordinates(tied.model, tied.kept, (2,), ())
+    assert p.shape == (tied.size, 1 + len(tied.kept))
     assert p[2, 0] == 1.0 and p[:6, 0].sum() == 1.0
 
 

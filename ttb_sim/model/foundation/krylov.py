@@ -77,14 +77,18 @@ def _positive_definite_solve(a: sp.csr_matrix) -> Solve:
 
 @dataclass(frozen=True)
 class MirrorPart:
-    """One mirror-symmetry class of the master: its components and coordinates P."""
+    """
+    One mirror-symmetry class of the master: its components, coordinates P and matrices.
+
+    ``stiffness``, ``damping`` and ``mass`` are P^T K P, P^T C P and P^T M P,
+    restricted once for every shift (:func:`mirror_parts`).
+    """
 
     components: tuple[int, ...]
     coordinates: sp.csr_matrix
-
-    def restricted(self, a: sp.spmatrix) -> sp.csr_matrix:
-        """Return P^T A P."""
-        return (self.coordinates.T @ a @ self.coordinates).tocsr()
+    stiffness: sp.csr_matrix
+    damping: sp.csr_matrix
+    mass: sp.csr_matrix
 
     def lifted(self, solve: Solve) -> Solve:
         """Return the whole-space solve x = P (P^T Z P)^-1 P^T r of a class's loads r."""
@@ -104,7 +108,7 @@ def reduction_basis(tied: TiedSubstructure, reduction: ReductionParameters,
     after each shift with the number of shifts finished (the static one first).
     """
     report = progress if progress is not None else (lambda done: None)
-    k, c, m = tied.stiffness, tied.damping, tied.mass
+    c, m = tied.damping, tied.mass
     n = tied.size
     weight = m.diagonal()
     b = np.zeros((n, 6))
@@ -113,7 +117,7 @@ def reduction_basis(tied: TiedSubstructure, reduction: ReductionParameters,
     x0 = np.empty((n, 6))
     blocks: list[np.ndarray] = []
     for part in parts:  # one factorisation in memory at a time
-        static = part.lifted(_positive_definite_solve(part.restricted(k)))
+        static = part.lifted(_positive_definite_solve(part.stiffness))
         cols = list(part.components)
         x0[:, cols] = static(b[:, cols])
         if 0.0 in reduction.shifts:
@@ -153,34 +157,32 @@ def mirror_parts(tied: TiedSubstructure) -> list[MirrorPart]:
     of the whole, which is what the class split is for). A model whose matrices
     break the mirror is solved whole (one part of all six components).
     """
-    model = tied.model
-    kept = tied.transform[:, 6:].tocsc().indices
-    whole = [MirrorPart(tuple(range(6)), sp.identity(tied.size, format='csr'))]
-    parts = [MirrorPart(comps, class_coordinates(model, kept, comps, planes))
-             for comps, planes in symmetry_classes(model, tied.transform)]
-    if len(parts) == 1:
-        return whole
     matrices = (tied.stiffness, tied.damping, tied.mass)
-    if not all(invariant(matrices, part.coordinates) for part in parts):
+    whole = [MirrorPart(tuple(range(6)), sp.identity(tied.size, format='csr'), *matrices)]
+    classes = [(comps, class_coordinates(tied.model, tied.kept, comps, planes))
+               for comps, planes in symmetry_classes(tied.model, tied.transform)]
+    if len(classes) == 1:
+        return whole
+    if not all(invariant(matrices, p) for _, p in classes):
         LOG.info("reduction: the matrices break the mesh's mirror symmetry; solving the "
                  'whole system at each shift')
         return whole
-    return parts
+    return [MirrorPart(comps, p, *((p.T @ a @ p).tocsr() for a in matrices))
+            for comps, p in classes]
 
 
 def _shift_blocks(tied: TiedSubstructure, part: MirrorPart, w: float,
                   reduction: ReductionParameters, weight: np.ndarray,
                   b: np.ndarray) -> list[np.ndarray]:
     """Return one class's Krylov blocks at the shift w (rad/s) on ``reduction``'s axis."""
-    k, c, m = tied.stiffness, tied.damping, tied.mass
+    c, m = tied.damping, tied.mass
     cols = list(part.components)
     if reduction.shift_axis == 'real':
-        pencil = part.restricted(_symmetric(k + w * c + (w * w) * m))
+        pencil = _symmetric(part.stiffness + w * part.damping + (w * w) * part.mass)
         solve = part.lifted(_positive_definite_solve(pencil))
         return _soar(solve, (c + 2 * w * m).tocsr(), m, weight, b[:, cols],
                      reduction.levels, reduction.tolerance)
-    solve = part.lifted(_complex_solver(part.restricted(k), part.restricted(c),
-                                        part.restricted(m), w))
+    solve = part.lifted(_complex_solver(part.stiffness, part.damping, part.mass, w))
     found = _soar(solve, (c + 2j * w * m).tocsr(), m, weight, b[:, cols].astype(complex),
                   reduction.levels, reduction.tolerance)
     return [piece for q in found for piece in (q.real, q.imag)]

@@ -42,7 +42,7 @@ from ttb_sim.model.foundation.records import FoundationError, ReductionParameter
 
 LOG = logging.getLogger(__name__)
 
-FORMAT = 4
+FORMAT = 5
 """Version of the reduction and of its cache files; part of the cache key."""
 
 

@@ -66,6 +66,11 @@ class TiedSubstructure:
         """Number of coordinates n_x."""
         return int(self.transform.shape[1])
 
+    @property
+    def kept(self) -> np.ndarray:
+        """The free DOFs off the cap top, in the order of x[6:] (one 1 per column of T)."""
+        return self.transform[:, 6:].tocsc().indices
+
 
 def check_spec(spec: Substructure) -> None:
     """
