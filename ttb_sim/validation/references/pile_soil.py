@@ -18,7 +18,9 @@ Closed forms for the pile-soil validation cases V11-V16 (PHYSICS.md 9.4-9.5).
 Independent of the finite-element code: the Randolph-Wroth head stiffness of
 a single pile, Gazetas' fit for the same, the modes of a layered shear column
 on a rigid base (exact, from the layer transfer matrices, and the
-quarter-wavelength estimate with the travel-time average Vs), the surface
+quarter-wavelength estimate with the travel-time average Vs), the damped
+first mode of such a column restrained along its depth by distributed springs
+and dashpots (a block's side boundary spread over its plan), the surface
 receptance of a layered column on a half-space under a harmonic load, and the
 Clough-Duncan hyperbola with its Mohr-Coulomb cap.
 """
@@ -26,10 +28,10 @@ Clough-Duncan hyperbola with its Mohr-Coulomb cap.
 from __future__ import annotations
 
 import math
-from typing import Sequence
+from typing import Callable, Sequence
 
 import numpy as np
-from scipy.optimize import brentq
+from scipy.optimize import brentq, newton
 
 
 def randolph_wroth_stiffness(g_l: float, nu: float, length: float, radius: float,
@@ -149,6 +151,50 @@ def shear_column_frequencies(thicknesses: Sequence[float], shear_moduli: Sequenc
         if len(roots) == n:
             break
     return np.array(roots)
+
+
+SUBLAYER = 0.05
+"""Thickness (m) of the uniform slices of :func:`restrained_column_root` (its restraint varies
+with depth; halving it moves the root of ``pile_harmonic``'s column by 2e-8)."""
+
+
+def restrained_column_root(thicknesses: Sequence[float], moduli: Sequence[float],
+                           densities: Sequence[float], springs: Callable[[float], float],
+                           dashpots: Callable[[float], float], guess: float) -> complex:
+    """
+    Return the complex root s (1/s) of a layered column on a rigid base, restrained in depth.
+
+    Free surface on top, fixed base; at depth z the column carries
+    rho u_tt = E u_zz - k(z) u - c(z) u_t (E the layer's modulus, k and c per unit
+    volume, N/m^4 and N s/m^4). In slices of :data:`SUBLAYER` (each layer cut
+    evenly, k and c at the slice's mid-depth) the solution is exact:
+    kappa^2 = (rho s^2 + c s + k) / E, transfer matrix of (u, tau) in cosh and sinh
+    of kappa t. The root of the base displacement is found by the secant method
+    in the complex plane from s = i 2 pi ``guess`` (Hz), e.g. the unrestrained
+    column's mode of :func:`shear_column_frequencies`. Its natural frequency is
+    abs(s) / 2 pi, its damping ratio -Re(s) / abs(s).
+    """
+    slices = []
+    top = 0.0
+    for t, e, rho in zip(thicknesses, moduli, densities):
+        n = max(1, math.ceil(t / SUBLAYER))
+        h = t / n
+        for k in range(n):
+            z = top + (k + 0.5) * h
+            slices.append((h, e, rho, springs(z), dashpots(z)))
+        top += t
+
+    def base_displacement(s: complex) -> complex:
+        u, tau = 1.0 + 0j, 0j
+        for h, e, rho, k, c in slices:
+            kappa = np.sqrt(complex((rho * s * s + c * s + k) / e))
+            ch, sh = np.cosh(kappa * h), np.sinh(kappa * h)
+            u, tau = u * ch + tau * sh / (e * kappa), u * e * kappa * sh + tau * ch
+        return complex(u)
+
+    start = 2j * math.pi * guess
+    return complex(newton(base_displacement, start, x1=start * 1.02 - 0.02 * abs(start),
+                          tol=1e-12, maxiter=200))
 
 
 def layered_column_receptance(thicknesses: Sequence[float], moduli: Sequence[float],
