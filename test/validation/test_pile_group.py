@@ -179,6 +179,15 @@ def test_transient_fit_of_a_harmonic_start_needs_the_moving_average_inside_the_r
     assert fitted.natural == pytest.approx(0.84, rel=0.02)
 
 
+def test_transient_fit_of_a_hump_without_ringing_has_no_damping():
+    """One decaying hump is no ringing: the spectral peak, damping unknown (NaN)."""
+    t = np.arange(0.0, 2.0, 1e-3)
+    hump = 2e-6 * np.exp(-t / 0.05) + 1e-8 * np.sin(2 * math.pi * 3.1 * t)
+    fitted = fit_transient(t, hump)
+    assert math.isnan(fitted.damping)
+    assert fitted.natural == fitted.frequency
+
+
 def test_restrained_column_root_is_the_undamped_stratum_without_restraint():
     thickness, modulus, rho = [2.0, 4.0, 16.0], [6.0e6, 6.0e6, 7.2e6], [1835.0, 1937.0, 1529.0]
     f0 = shear_column_frequencies(thickness, modulus, rho, 1)[0]

@@ -81,6 +81,8 @@ RINGING_SECONDS = 4.0
 """Duration (s) of the rigid-base runs."""
 PAPER_TRANSIENT_HZ = 1.2
 """[P] Fig. 10's transient (reported only)."""
+RINGING_DAMPING = 0.5
+"""Damping ratio from which a fitted cosine is no ringing: one period later 2.6 % is left."""
 
 
 @dataclass(frozen=True)
@@ -106,9 +108,9 @@ def fit_transient(t: np.ndarray, slow: np.ndarray) -> Transient:
     started from rest gives the pile head an impulse: the soil around it
     settles within tenths of a second without ringing (the exponential), while
     the domain's first mode rings on (the cosine). The fit starts from the
-    spectral peak between 0.3 and 5 Hz; when it lands outside that band (no
-    damped oscillation in the record) the spectral peak is returned, its damping
-    unknown (NaN).
+    spectral peak between 0.3 and 5 Hz; when it lands outside that band, or
+    at a damping ratio of :data:`RINGING_DAMPING` or more (no damped oscillation
+    in the record), the spectral peak is returned, its damping unknown (NaN).
     """
     def model(tt: np.ndarray, a: float, zeta: float, f: float, phase: float, b: float,
               tau: float, c: float) -> np.ndarray:
@@ -130,8 +132,9 @@ def fit_transient(t: np.ndarray, slow: np.ndarray) -> Transient:
         return Transient(guess)
     fitted = float(abs(p[2]))
     # a record without a damped oscillation (a single decaying hump) fits a near-zero
-    # frequency: report the spectral peak of the searched band instead
-    if 0.3 < fitted < 5.0 and 0.0 <= p[1] < 1.0:
+    # frequency or a damping that leaves nothing of a second swing: report the spectral
+    # peak of the searched band instead
+    if 0.3 < fitted < 5.0 and 0.0 <= p[1] < RINGING_DAMPING:
         return Transient(fitted, float(p[1]))
     return Transient(guess)
 
