@@ -88,9 +88,14 @@ class SoilLayer:
         return math.sqrt(self.G / self.rho)
 
     @property
+    def constrained_modulus(self) -> float:
+        """Constrained (oedometric) modulus E (1 - nu) / ((1 + nu) (1 - 2 nu)) (Pa)."""
+        return self.E * (1 - self.nu) / ((1 + self.nu) * (1 - 2 * self.nu))
+
+    @property
     def vp(self) -> float:
         """Compression-wave speed (m/s)."""
-        return math.sqrt(self.E * (1 - self.nu) / ((1 + self.nu) * (1 - 2 * self.nu) * self.rho))
+        return math.sqrt(self.constrained_modulus / self.rho)
 
 
 #: The three layers of [P] Table 5, moduli read in Pa (PHYSICS.md 6.1), rho = gamma / g.

@@ -249,8 +249,8 @@ def stratum_frequencies(layers: Sequence[SoilLayer], n: int = 2) -> dict[str, np
     """
     thickness = [lay.thickness for lay in layers]
     rho = [lay.rho for lay in layers]
-    shear = [lay.E / (2 * (1 + lay.nu)) for lay in layers]
-    constrained = [lay.E * (1 - lay.nu) / ((1 + lay.nu) * (1 - 2 * lay.nu)) for lay in layers]
+    shear = [lay.G for lay in layers]
+    constrained = [lay.constrained_modulus for lay in layers]
     return {'shear': shear_column_frequencies(thickness, shear, rho, n),
             'vertical': shear_column_frequencies(thickness, constrained, rho, n)}
 
@@ -270,10 +270,6 @@ def boundary_runs(overrides: Sequence[str] = (), boundaries: Sequence[str] = BOU
         runs[b] = harmonic_run(load_scenario('pile_harmonic',
                                              [*overrides, f'soil.boundary={b}', *longer]))
     return runs
-
-
-def _constrained(layer: SoilLayer) -> float:
-    return layer.E * (1 - layer.nu) / ((1 + layer.nu) * (1 - 2 * layer.nu))
 
 
 SIDE_POINTS = 400
@@ -305,18 +301,16 @@ def restrained_stratum(layers: Sequence[SoilLayer], lx: float, ly: float,
         return layers[min(int(np.searchsorted(tops, z, side='right')) - 1, len(layers) - 1)]
 
     def springs(z: float) -> float:
-        lay = layer(z)
-        g = lay.E / (2 * (1 + lay.nu))
         inverse = sum(width * float(np.mean(1.0 / np.sqrt(dx * dx + dy * dy + z * z)))
                       for dx, dy, width in faces)
-        return alpha_t * g * inverse / area
+        return alpha_t * layer(z).G * inverse / area
 
     def dashpots(z: float) -> float:
         lay = layer(z)
-        return 2 * (lx + ly) / area * lay.rho * math.sqrt(lay.E / (2 * (1 + lay.nu)) / lay.rho)
+        return 2 * (lx + ly) / area * lay.rho * lay.vs
 
     thickness = [lay.thickness for lay in layers]
-    moduli = [_constrained(lay) for lay in layers]
+    moduli = [lay.constrained_modulus for lay in layers]
     rho = [lay.rho for lay in layers]
     guess = float(shear_column_frequencies(thickness, moduli, rho, 1)[0])
     root = restrained_column_root(thickness, moduli, rho, springs, dashpots, guess)
