@@ -61,7 +61,7 @@ from scipy.optimize import curve_fit, OptimizeWarning
 from ttb_sim.config import load_scenario, Scenario
 from ttb_sim.model.foundation.records import SoilLayer
 from ttb_sim.sim import SubstructureRun
-from ttb_sim.validation.cases.pile_soil import split_response
+from ttb_sim.validation.cases.pile_soil import load_period_samples, split_response
 from ttb_sim.validation.references.independent_fe import IndependentBlock
 from ttb_sim.validation.references.pile_soil import (restrained_column_root,
                                                      shear_column_frequencies)
@@ -91,6 +91,11 @@ class Transient:
 
     frequency: float
     damping: float = math.nan
+
+    @classmethod
+    def of_root(cls, root: complex) -> Transient:
+        """Return the mode of a complex root s (1/s): damped |Im s| / 2 pi, zeta -Re s / |s|."""
+        return cls(abs(root.imag) / (2 * math.pi), -root.real / abs(root))
 
     @property
     def natural(self) -> float:
@@ -149,8 +154,7 @@ def averaged_part(t: np.ndarray, slow: np.ndarray, frequency: float
     window runs over the record's edge, and a harmonic started from rest leaves
     a hump there (about 2 / pi of half its amplitude) that a fit would chase.
     """
-    n = max(1, int(round(1.0 / (frequency * (t[1] - t[0])))))
-    edge = n // 2 + 1
+    edge = load_period_samples(t, frequency) // 2 + 1
     return t[edge:len(t) - edge], slow[edge:len(slow) - edge]
 
 
@@ -313,10 +317,8 @@ def restrained_stratum(layers: Sequence[SoilLayer], lx: float, ly: float,
     moduli = [lay.constrained_modulus for lay in layers]
     rho = [lay.rho for lay in layers]
     guess = float(shear_column_frequencies(thickness, moduli, rho, 1)[0])
-    root = restrained_column_root(thickness, moduli, rho, springs, dashpots, guess)
-    natural = abs(root) / (2 * math.pi)
-    damping = -root.real / abs(root)
-    return Transient(natural * math.sqrt(max(0.0, 1.0 - damping**2)), damping)
+    return Transient.of_root(
+        restrained_column_root(thickness, moduli, rho, springs, dashpots, guess))
 
 
 def domain_modes(scenario: Scenario) -> dict[str, Transient]:
@@ -356,7 +358,7 @@ def transient_rows(layers: Sequence[SoilLayer], runs: Mapping[str, HarmonicRecor
     first = float(closed['vertical'][0])
     for boundary, run in runs.items():
         label = f'pile transient, {boundary}'
-        domain = domains.get(boundary) if boundary in RIGID_BASE else None
+        domain = domains.get(boundary)
         if domain is not None:
             rows.append(relative_row('V15', f'{label}: natural frequency',
                                      run.pile_transient.natural, domain.natural,

@@ -202,6 +202,11 @@ def v14() -> list[Row]:
                          randolph_wroth_reference(scenario.substructure()), 0.15, 'N/m')]
 
 
+def load_period_samples(t: np.ndarray, frequency: float) -> int:
+    """Return the samples of the record ``t`` in one load period (at least one)."""
+    return max(1, int(round(1.0 / (frequency * (t[1] - t[0])))))
+
+
 def split_response(t: np.ndarray, x: np.ndarray, frequency: float
                    ) -> tuple[float, np.ndarray]:
     """
@@ -211,7 +216,7 @@ def split_response(t: np.ndarray, x: np.ndarray, frequency: float
     ``frequency``] over the whole record, the slow part being taken out first
     by a moving average over one load period.
     """
-    n = max(1, int(round(1.0 / (frequency * (t[1] - t[0])))))
+    n = load_period_samples(t, frequency)
     slow = np.convolve(x, np.ones(n) / n, mode='same')
     fast = x - slow
     late = t > t[-1] / 2
